@@ -1,0 +1,40 @@
+# The two commands of the quick start, and a few more for developers.
+#   make run    build, then run the main job (until the daemon lands: the offline accuracy
+#               evaluation on generated data)
+#   make test   install what is missing, build, run every test
+BUILD ?= build
+JOBS ?= $(shell nproc)
+
+.PHONY: all deps configure build run test bench asan tsan clean
+
+all: build
+
+deps:
+	@bash scripts/install-deps.sh
+
+configure: deps
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
+
+build: configure
+	@cmake --build $(BUILD) -j$(JOBS)
+
+run: build
+	@bash scripts/run-demo-eval.sh $(BUILD)/bin
+
+test: build
+	@cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+
+bench: build
+	@$(BUILD)/bin/fremen_model_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+
+# Sanitizer builds in their own trees.
+asan: deps
+	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFREMEN_SANITIZE=address >/dev/null
+	@cmake --build build-asan -j$(JOBS) && cd build-asan && ctest --output-on-failure -j$(JOBS)
+
+tsan: deps
+	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFREMEN_SANITIZE=thread >/dev/null
+	@cmake --build build-tsan -j$(JOBS) && cd build-tsan && ctest --output-on-failure -j$(JOBS)
+
+clean:
+	@rm -rf $(BUILD) build-asan build-tsan

@@ -1,0 +1,59 @@
+#include "storage/model/static_state.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+namespace fremen::model {
+
+void StaticState::Observe(double t, float s) {
+  if (count() == 0) {
+    t_first = t;
+    span = 0;
+  } else {
+    const double last = std::max(t_last(), t);
+    t_first = std::min(t_first, t);
+    span = static_cast<float>(last - t_first);
+  }
+  count_value = ((count() + 1) << 1) | (s == 1.0f ? 1u : 0u);
+}
+
+namespace {
+// The mean of e^{-jω t_i} over n times evenly spread over [t0, t0 + span]: a geometric series.
+std::complex<double> MeanPhasorOfEvenTimes(double period, double t0, double span, uint32_t n) {
+  const std::complex<double> first = std::polar(1.0, -ReducedPhase(t0, period));
+  if (n < 2 || span == 0) return first;
+  const double step_phase = ReducedPhase(span / (n - 1), period);
+  const std::complex<double> ratio = std::polar(1.0, -step_phase);
+  const std::complex<double> denominator = 1.0 - ratio;
+  if (std::abs(denominator) < 1e-12) return first;  // the step is a whole number of periods
+  return first * (1.0 - std::pow(ratio, static_cast<double>(n))) / (static_cast<double>(n) * denominator);
+}
+}  // namespace
+
+template <typename Real>
+void StaticState::Promote(const ModelSettings& settings, BasicStateModel<Real>& out) const {
+  out = BasicStateModel<Real>(settings);
+  if (count() == 0) return;
+  BasicSpectrum<Real>& spectrum = out.mutable_spectrum();
+  SpectrumHeader& h = spectrum.mutable_header();
+  h.n = count();
+  h.sum_s = value() * static_cast<double>(count());
+  h.t_first = t_first;
+  h.t_last = t_last();
+  for (size_t k = 0; k < settings.periods.size(); ++k) {
+    const std::complex<double> e = MeanPhasorOfEvenTimes(settings.periods.period(k), t_first, span, count());
+    spectrum.set_means(k, static_cast<double>(value()) * e, e);
+  }
+  Persistence& persistence = out.mutable_persistence();
+  persistence.observed = 1;
+  persistence.t_last = t_last();
+  persistence.s_last = value();
+  persistence.samples = count() - 1;
+  out.set_published(PublishedModel::MeanOnly(value()));
+}
+
+template void StaticState::Promote(const ModelSettings&, BasicStateModel<float>&) const;
+template void StaticState::Promote(const ModelSettings&, BasicStateModel<double>&) const;
+
+}  // namespace fremen::model
