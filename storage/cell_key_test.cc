@@ -1,0 +1,50 @@
+#include "storage/cell_key.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+
+namespace fremen::storage {
+namespace {
+
+TEST(CellKeyTest, MortonRoundTripsAndInterleaves) {
+  EXPECT_EQ(MortonKey(1, 0, 0), 1u);
+  EXPECT_EQ(MortonKey(0, 1, 0), 2u);
+  EXPECT_EQ(MortonKey(0, 0, 1), 4u);
+  EXPECT_EQ(MortonKey(3, 3, 3), 63u);
+  std::mt19937 rng(1);
+  std::uniform_int_distribution<uint32_t> any(0, kMaxGridIndex);
+  for (int i = 0; i < 10000; ++i) {
+    const uint32_t x = any(rng), y = any(rng), z = any(rng);
+    const auto cell = MortonCell(MortonKey(x, y, z));
+    ASSERT_EQ(cell[0], x);
+    ASSERT_EQ(cell[1], y);
+    ASSERT_EQ(cell[2], z);
+  }
+}
+
+TEST(CellKeyTest, AnAlignedBlockIsOneBrick) {
+  std::set<uint64_t> bricks;
+  for (uint32_t x = 8; x < 16; ++x)
+    for (uint32_t y = 16; y < 24; ++y)
+      for (uint32_t z = 0; z < 8; ++z) bricks.insert(BrickOf(MortonKey(x, y, z)));
+  EXPECT_EQ(bricks.size(), 1u);
+}
+
+TEST(CellKeyTest, ShardsAreBalancedAndBrickAligned) {
+  std::vector<int> per_shard(4, 0);
+  for (uint32_t x = 0; x < 256; ++x)
+    for (uint32_t y = 0; y < 256; ++y) per_shard[ShardOf(MortonKey(x, y, 0), 4)]++;
+  for (int count : per_shard) EXPECT_NEAR(count, 65536 / 4, 65536 / 16);
+  EXPECT_EQ(ShardOf(MortonKey(8, 8, 8), 4), ShardOf(MortonKey(15, 15, 15), 4));
+}
+
+TEST(CellKeyTest, KeyBytesSortLikeKeys) {
+  const auto a = KeyBytes(0x0102030405060708ull);
+  EXPECT_EQ(KeyFromBytes(a.data()), 0x0102030405060708ull);
+  EXPECT_LT(KeyBytes(255), KeyBytes(256));
+}
+
+}  // namespace
+}  // namespace fremen::storage

@@ -1,0 +1,212 @@
+#include "storage/lmdb/lmdb_env.h"
+
+#include <sys/stat.h>
+
+#include <cstring>
+
+#include "absl/strings/str_cat.h"
+
+namespace fremen::storage {
+
+absl::Status LmdbStatus(int rc, absl::string_view what) {
+  if (rc == MDB_SUCCESS) return absl::OkStatus();
+  const std::string message = absl::StrCat(what, ": ", mdb_strerror(rc));
+  switch (rc) {
+    case MDB_NOTFOUND:
+      return absl::NotFoundError(message);
+    case MDB_CORRUPTED:
+    case MDB_PAGE_NOTFOUND:
+    case MDB_INVALID:
+    case MDB_VERSION_MISMATCH:
+      return absl::DataLossError(message);
+    case MDB_MAP_FULL:
+    case MDB_READERS_FULL:
+    case MDB_TXN_FULL:
+    case MDB_DBS_FULL:
+    case ENOMEM:
+    case ENOSPC:
+      return absl::ResourceExhaustedError(message);
+    case EACCES:
+      return absl::PermissionDeniedError(message);
+    default:
+      return absl::InternalError(message);
+  }
+}
+
+absl::StatusOr<MDB_dbi> LmdbTxn::OpenDb(const char* name, bool create) {
+  MDB_dbi dbi;
+  const int rc = mdb_dbi_open(txn_, name, create ? MDB_CREATE : 0, &dbi);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, absl::StrCat("mdb_dbi_open ", name ? name : "(main)"));
+  return dbi;
+}
+
+absl::Status LmdbTxn::Put(MDB_dbi dbi, std::span<const uint8_t> key, std::span<const uint8_t> value,
+                          unsigned flags) {
+  MDB_val k = AsVal(key), v = AsVal(value);
+  const int rc = mdb_put(txn_, dbi, &k, &v, flags);
+  if (rc == MDB_MAP_FULL) map_full_ = true;
+  return LmdbStatus(rc, "mdb_put");
+}
+
+absl::StatusOr<std::span<const uint8_t>> LmdbTxn::Get(MDB_dbi dbi, std::span<const uint8_t> key) const {
+  MDB_val k = AsVal(key), v;
+  const int rc = mdb_get(txn_, dbi, &k, &v);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_get");
+  return AsBytes(v);
+}
+
+absl::Status LmdbTxn::Delete(MDB_dbi dbi, std::span<const uint8_t> key) {
+  MDB_val k = AsVal(key);
+  const int rc = mdb_del(txn_, dbi, &k, nullptr);
+  return rc == MDB_NOTFOUND ? absl::OkStatus() : LmdbStatus(rc, "mdb_del");
+}
+
+absl::Status LmdbTxn::Drop(MDB_dbi dbi) { return LmdbStatus(mdb_drop(txn_, dbi, 0), "mdb_drop"); }
+
+absl::Status LmdbTxn::Scan(MDB_dbi dbi, std::span<const uint8_t> begin, std::span<const uint8_t> end,
+                           const std::function<bool(std::span<const uint8_t>, std::span<const uint8_t>)>& f) const {
+  MDB_cursor* cursor;
+  int rc = mdb_cursor_open(txn_, dbi, &cursor);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_cursor_open");
+  MDB_val k = AsVal(begin), v;
+  rc = mdb_cursor_get(cursor, &k, &v, begin.empty() ? MDB_FIRST : MDB_SET_RANGE);
+  while (rc == MDB_SUCCESS) {
+    const std::span<const uint8_t> key = AsBytes(k);
+    if (!end.empty()) {
+      const int cmp = std::memcmp(key.data(), end.data(), std::min(key.size(), end.size()));
+      if (cmp > 0 || (cmp == 0 && key.size() >= end.size())) break;
+    }
+    if (!f(key, AsBytes(v))) break;
+    rc = mdb_cursor_get(cursor, &k, &v, MDB_NEXT);
+  }
+  mdb_cursor_close(cursor);
+  return rc == MDB_SUCCESS || rc == MDB_NOTFOUND ? absl::OkStatus() : LmdbStatus(rc, "mdb_cursor_get");
+}
+
+absl::StatusOr<size_t> LmdbTxn::Count(MDB_dbi dbi) const {
+  MDB_stat stat;
+  const int rc = mdb_stat(txn_, dbi, &stat);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_stat");
+  return stat.ms_entries;
+}
+
+absl::StatusOr<std::unique_ptr<LmdbEnv>> LmdbEnv::Open(const std::string& dir, const LmdbOptions& options) {
+  if (mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) {
+    return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", std::strerror(errno)));
+  }
+  MDB_env* env;
+  int rc = mdb_env_create(&env);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_env_create");
+  mdb_env_set_maxdbs(env, options.max_dbs);
+  mdb_env_set_maxreaders(env, options.max_readers);
+  mdb_env_set_mapsize(env, options.initial_map_size);
+  // NOTLS: read transactions are not tied to a thread (handlers may hop threads). NORDAHEAD: the
+  // access pattern is random lookups or full scans into memory, where readahead only pollutes.
+  unsigned flags = MDB_NOTLS | MDB_NORDAHEAD | (options.no_sync ? MDB_NOSYNC : 0);
+  rc = mdb_env_open(env, dir.c_str(), flags, 0640);
+  if (rc != MDB_SUCCESS) {
+    mdb_env_close(env);
+    return LmdbStatus(rc, absl::StrCat("mdb_env_open ", dir));
+  }
+  MDB_envinfo info;
+  mdb_env_info(env, &info);
+  auto result = std::unique_ptr<LmdbEnv>(new LmdbEnv(env, dir, info.me_mapsize));
+  int dead = 0;
+  mdb_reader_check(env, &dead);  // slots of processes killed while reading
+  return result;
+}
+
+LmdbEnv::~LmdbEnv() { mdb_env_close(env_); }
+
+absl::Status LmdbEnv::health() const {
+  std::lock_guard lock(latch_mutex_);
+  return latched_;
+}
+
+void LmdbEnv::Latch(const absl::Status& status) {
+  std::lock_guard lock(latch_mutex_);
+  if (latched_.ok()) latched_ = status;
+}
+
+absl::Status LmdbEnv::Grow() {
+  std::unique_lock lock(resize_);  // waits for every read transaction to end
+  const size_t bigger = map_size_ * 2;
+  const int rc = mdb_env_set_mapsize(env_, bigger);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_env_set_mapsize");
+  map_size_ = bigger;
+  return absl::OkStatus();
+}
+
+absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {
+  std::lock_guard writer(writer_);
+  if (absl::Status latched = health(); !latched.ok()) return latched;
+  for (;;) {
+    int rc;
+    MDB_txn* txn = nullptr;
+    {
+      std::shared_lock lock(resize_);
+      rc = mdb_txn_begin(env_, nullptr, 0, &txn);
+      if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin");
+      LmdbTxn wrapped(txn);
+      absl::Status status = f(wrapped);
+      if (!status.ok()) {
+        mdb_txn_abort(txn);
+        if (!wrapped.map_full()) return status;
+        rc = MDB_MAP_FULL;
+      } else {
+        rc = mdb_txn_commit(txn);
+        if (rc == MDB_SUCCESS) return absl::OkStatus();
+      }
+    }
+    if (rc != MDB_MAP_FULL) {
+      // A failed commit may have left the data file behind the caller's belief: refuse later writes.
+      absl::Status failed = LmdbStatus(rc, "mdb_txn_commit");
+      Latch(failed);
+      return failed;
+    }
+    if (absl::Status grown = Grow(); !grown.ok()) return grown;
+  }
+}
+
+absl::Status LmdbEnv::Read(const std::function<absl::Status(LmdbTxn&)>& f) const {
+  std::shared_lock lock(resize_);
+  MDB_txn* txn;
+  const int rc = mdb_txn_begin(env_, nullptr, MDB_RDONLY, &txn);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin (read)");
+  LmdbTxn wrapped(txn);
+  absl::Status status = f(wrapped);
+  mdb_txn_abort(txn);
+  return status;
+}
+
+absl::Status LmdbEnv::Sync() {
+  absl::Status status = LmdbStatus(mdb_env_sync(env_, 1), "mdb_env_sync");
+  if (!status.ok()) Latch(status);
+  return status;
+}
+
+absl::StatusOr<int> LmdbEnv::ClearStaleReaders() {
+  int dead = 0;
+  const int rc = mdb_reader_check(env_, &dead);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_reader_check");
+  return dead;
+}
+
+absl::Status LmdbEnv::CopyTo(const std::string& dir) const {
+  if (mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) {
+    return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", std::strerror(errno)));
+  }
+  std::shared_lock lock(resize_);
+  return LmdbStatus(mdb_env_copy2(env_, dir.c_str(), MDB_CP_COMPACT), absl::StrCat("mdb_env_copy2 ", dir));
+}
+
+absl::StatusOr<size_t> LmdbEnv::UsedBytes() const {
+  MDB_envinfo info;
+  MDB_stat stat;
+  int rc = mdb_env_info(env_, &info);
+  if (rc == MDB_SUCCESS) rc = mdb_env_stat(env_, &stat);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_env_info");
+  return (info.me_last_pgno + 1) * static_cast<size_t>(stat.ms_psize);
+}
+
+}  // namespace fremen::storage

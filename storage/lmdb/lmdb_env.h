@@ -1,0 +1,128 @@
+// A thin, safe wrapper over one LMDB environment (one directory, one data file).
+//
+// What it adds to LMDB (see lmdb.h):
+// - every return code becomes an absl::Status in one place (LmdbStatus), MDB_CORRUPTED and
+//   MDB_PAGE_NOTFOUND as DataLoss, MDB_MAP_FULL as ResourceExhausted;
+// - write transactions that hit MDB_MAP_FULL are aborted, the map is grown (doubled, while no
+//   transaction of this process is active) and the transaction is run again — so callers write a
+//   function that can be retried, never a half-applied one;
+// - stale reader slots of dead processes are cleared at open and on demand (mdb_reader_check);
+// - a failed commit/sync latches the environment: every later write fails with the first error
+//   (the leveldb bg_error_ pattern) instead of pretending data is durable.
+//
+// Thread-safety: one writer at a time (Write serialises writers); any number of concurrent readers
+// (Read). Read transactions are short: they hold a shared lock that map growth waits for.
+#pragma once
+
+#include <lmdb.h>
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+
+namespace fremen::storage {
+
+// Converts an LMDB return code; `what` names the operation ("mdb_put spectra").
+absl::Status LmdbStatus(int rc, absl::string_view what);
+
+struct LmdbOptions {
+  // Initial map size in bytes; doubled whenever a write runs out of space. Small values are fine
+  // (the map grows), large ones only reserve address space. Default: 64 MiB.
+  size_t initial_map_size = 64ull << 20;
+  // Named databases the environment may hold. Default: 16.
+  unsigned max_dbs = 16;
+  // Reader slots (concurrent read transactions across processes). Default: 126 (LMDB's default).
+  unsigned max_readers = 126;
+  // Skip fsync at commit: only for data whose durability comes from elsewhere (the write-ahead
+  // log) and that is synced explicitly with Sync() before the log is trimmed. Default: false.
+  bool no_sync = false;
+};
+
+// A byte view of an LMDB value, valid until its transaction ends.
+inline std::span<const uint8_t> AsBytes(const MDB_val& v) {
+  return {static_cast<const uint8_t*>(v.mv_data), v.mv_size};
+}
+inline MDB_val AsVal(std::span<const uint8_t> bytes) {
+  return {bytes.size(), const_cast<uint8_t*>(bytes.data())};
+}
+
+class LmdbTxn {
+ public:
+  explicit LmdbTxn(MDB_txn* txn) : txn_(txn) {}
+  MDB_txn* get() const { return txn_; }
+
+  // The named database (created in write transactions when missing).
+  absl::StatusOr<MDB_dbi> OpenDb(const char* name, bool create);
+  absl::Status Put(MDB_dbi dbi, std::span<const uint8_t> key, std::span<const uint8_t> value, unsigned flags = 0);
+  // NotFound when absent; the view is valid until the transaction ends.
+  absl::StatusOr<std::span<const uint8_t>> Get(MDB_dbi dbi, std::span<const uint8_t> key) const;
+  // OK whether or not the key existed.
+  absl::Status Delete(MDB_dbi dbi, std::span<const uint8_t> key);
+  absl::Status Drop(MDB_dbi dbi);
+  // Calls f(key, value) for keys in [begin, end) in key order (end empty: to the last key) until f
+  // returns false.
+  absl::Status Scan(MDB_dbi dbi, std::span<const uint8_t> begin, std::span<const uint8_t> end,
+                    const std::function<bool(std::span<const uint8_t>, std::span<const uint8_t>)>& f) const;
+  absl::StatusOr<size_t> Count(MDB_dbi dbi) const;
+
+  // Whether a put ran out of map space (LmdbEnv::Write then grows the map and retries).
+  bool map_full() const { return map_full_; }
+
+ private:
+  MDB_txn* txn_;
+  bool map_full_ = false;
+};
+
+class LmdbEnv {
+ public:
+  static absl::StatusOr<std::unique_ptr<LmdbEnv>> Open(const std::string& dir, const LmdbOptions& options);
+  ~LmdbEnv();
+  LmdbEnv(const LmdbEnv&) = delete;
+  LmdbEnv& operator=(const LmdbEnv&) = delete;
+
+  // Runs f in a write transaction and commits it. f may run more than once (after map growth) and
+  // must not have effects outside the transaction until Write returns OK. A non-OK status from f
+  // aborts the transaction and is returned.
+  absl::Status Write(const std::function<absl::Status(LmdbTxn&)>& f);
+  // Runs f in a read-only snapshot.
+  absl::Status Read(const std::function<absl::Status(LmdbTxn&)>& f) const;
+
+  // Flushes to disk (for no_sync environments).
+  absl::Status Sync();
+  // Clears reader slots left by dead processes; returns how many.
+  absl::StatusOr<int> ClearStaleReaders();
+  // A consistent copy (compacted) into an existing empty directory, while writers go on.
+  absl::Status CopyTo(const std::string& dir) const;
+
+  size_t map_size() const { return map_size_; }
+  // Bytes of the data file in use (pages up to the last one written).
+  absl::StatusOr<size_t> UsedBytes() const;
+  const std::string& dir() const { return dir_; }
+  // The latched error of a failed commit or sync, OK when healthy.
+  absl::Status health() const;
+
+ private:
+  LmdbEnv(MDB_env* env, std::string dir, size_t map_size) : env_(env), dir_(std::move(dir)), map_size_(map_size) {}
+  absl::Status Grow();
+  void Latch(const absl::Status& status);
+
+  MDB_env* env_;
+  std::string dir_;
+  size_t map_size_;
+  std::mutex writer_;                    // one write transaction at a time
+  mutable std::shared_mutex resize_;     // readers shared, map growth exclusive
+  mutable std::mutex latch_mutex_;
+  absl::Status latched_;
+};
+
+}  // namespace fremen::storage
