@@ -1,0 +1,87 @@
+// `fremenctl eval`: options, then the offline evaluation of offline_eval.h, printed as a table.
+#include "client/fremenctl/eval_command.h"
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "client/fremenctl/exit_codes.h"
+#include "client/fremenctl/offline_eval.h"
+#include "storage/model/model_settings.h"
+#include "storage/model/periods.h"
+
+namespace fremen::client {
+
+namespace {
+
+struct EvalOptions {
+  std::string train_path;
+  std::string test_path;
+  int periods = model::kDefaultPeriodCount;
+  double longest = model::kWeekSeconds;
+  bool floor_periods = false;
+  int max_order = model::kDefaultMaxOrder;
+  bool persistence = false;
+};
+
+// Reports a failure on stderr and ends the program with `exit_code` (kExitFailure or kExitUsage).
+[[noreturn]] void Fail(const absl::Status& status, int exit_code) {
+  std::fprintf(stderr, "fremenctl eval: %s\n", std::string(status.message()).c_str());
+  throw CLI::RuntimeError(exit_code);
+}
+
+void RunEval(const EvalOptions& options) {
+  absl::StatusOr<model::PeriodSet> periods =
+      model::PeriodSet::Harmonics(options.longest, options.periods, options.floor_periods);
+  // Options that pass their own checks can still make an invalid Ω (a period floored to 0 s).
+  if (!periods.ok()) Fail(periods.status(), kExitUsage);
+  model::ModelSettings settings;
+  settings.periods = *std::move(periods);
+  settings.max_order = options.max_order;
+  settings.persistence = options.persistence;
+
+  absl::StatusOr<std::vector<model::Observation>> train = ReadObservations(options.train_path);
+  if (!train.ok()) Fail(train.status(), kExitFailure);
+  absl::StatusOr<std::vector<model::Observation>> test = ReadObservations(options.test_path);
+  if (!test.ok()) Fail(test.status(), kExitFailure);
+
+  for (const OrderScore& score : EvaluateOffline(settings, *train, *test, options.persistence)) {
+    std::printf("%d\t%.4f\t%.4f\n", score.order, score.err, score.mse);
+  }
+}
+
+}  // namespace
+
+void RegisterEvalCommand(CLI::App& app) {
+  // Owned by the callback, which outlives parsing.
+  auto options = std::make_shared<EvalOptions>();
+  CLI::App* eval = app.add_subcommand("eval", "Offline accuracy of the FreMEn model of one state on `time state` files");
+  eval->add_option("--train", options->train_path, "Training data: one `time state` per line (seconds, [0, 1])")
+      ->required()
+      ->type_name("FILE");
+  eval->add_option("--test", options->test_path, "Test data, same format")->required()->type_name("FILE");
+  eval->add_option("--periods", options->periods, "Number of modelled periods K: T_k = longest / k, k = 1..K")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  eval->add_option("--longest", options->longest, "Longest modelled period in seconds (default: a week)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  eval->add_flag("--floor-periods", options->floor_periods,
+                 "Round periods down to whole seconds, T_k = floor(longest / k), as the original FremenServer does");
+  eval->add_option("--max-order", options->max_order, "Highest model order L evaluated (orders 0..L)")
+      ->check(CLI::Range(0, model::kMaxMaxOrder))
+      ->capture_default_str();
+  eval->add_flag("--persistence", options->persistence,
+                 "Blend the last training observation into the predictions (persistence model, paper §III-D)");
+  eval->footer(
+      "Trains one state on all of --train in one batch, then predicts every time of --test at each order\n"
+      "0..L and prints one line per order: order<TAB>err<TAB>mse. err is the mean of |[p > 0.5] - s| (for 0/1\n"
+      "states, the share of wrongly estimated samples), mse the mean of (p - s)^2.\n"
+      "Exit codes: 0 success, 1 unreadable or invalid data file (the message names file:line), 2 bad usage.\n"
+      "\n"
+      "Example, the setting of the original FremenServer's published figures:\n"
+      "  fremenctl eval --train train.txt --test test.txt --periods 100 --floor-periods");
+  eval->callback([options] { RunEval(*options); });
+}
+
+}  // namespace fremen::client

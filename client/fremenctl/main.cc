@@ -1,0 +1,25 @@
+// fremenctl: the command line of fremen. main() only builds the CLI11 application from the
+// subcommands and maps its outcome to the exit code: 0 success (or help), 1 the command failed
+// (e.g. bad input file), 2 bad usage.
+#include "CLI/CLI.hpp"
+#include "client/fremenctl/eval_command.h"
+#include "client/fremenctl/exit_codes.h"
+
+int main(int argc, char** argv) {
+  CLI::App app("fremenctl: the command line of the fremen FreMEn map database", "fremenctl");
+  app.require_subcommand(1);
+  app.footer("Run `fremenctl SUBCOMMAND --help` for a subcommand's options.\n"
+             "Exit codes: 0 success, 1 the command failed, 2 bad usage.");
+  fremen::client::RegisterEvalCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    // A command failed and has said why.
+    return e.get_exit_code();
+  } catch (const CLI::ParseError& e) {
+    // Prints help (exit 0) or the usage error; CLI11's own codes (100+) are mapped to one.
+    const int code = app.exit(e);
+    return code == 0 ? fremen::client::kExitOk : fremen::client::kExitUsage;
+  }
+  return fremen::client::kExitOk;
+}
