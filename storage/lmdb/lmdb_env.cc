@@ -14,6 +14,8 @@ absl::Status LmdbStatus(int rc, absl::string_view what) {
   switch (rc) {
     case MDB_NOTFOUND:
       return absl::NotFoundError(message);
+    case MDB_KEYEXIST:
+      return absl::AlreadyExistsError(message);
     case MDB_CORRUPTED:
     case MDB_PAGE_NOTFOUND:
     case MDB_INVALID:

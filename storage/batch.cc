@@ -1,0 +1,168 @@
+#include "storage/batch.h"
+
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "storage/cell_key.h"
+#include "storage/model/observation.h"
+#include "storage/model/varint.h"
+
+namespace fremen::storage {
+
+namespace {
+constexpr uint8_t kBatchVersion = 1;
+constexpr size_t kMaxLabelLength = 256;
+// A batch is one message of at most a few hundred MB; more observations than this is corruption.
+constexpr uint64_t kMaxBatchObservations = 1ull << 28;
+
+bool ValueOk(float v) { return v >= 0.0f && v <= 1.0f; }  // false for NaN
+}  // namespace
+
+absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch) {
+  if (!std::isfinite(batch.time) || std::fabs(batch.time) > model::kMaxAbsTime) {
+    return absl::InvalidArgumentError(absl::StrCat("time must be a finite time within ±1e13 s, got ", batch.time));
+  }
+  if (batch.keys.size() != batch.values.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("values must hold one value per state: ", batch.values.size(),
+                                                   " values for ", batch.keys.size(), " states"));
+  }
+  const DensePatch& patch = batch.patch;
+  const uint64_t patch_cells = uint64_t{patch.size[0]} * patch.size[1] * patch.size[2];
+  if (patch_cells != patch.values.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("patch.values must hold size.x·size.y·size.z = ", patch_cells,
+                                                   " values, got ", patch.values.size()));
+  }
+  if (batch.observation_count() > kMaxBatchObservations) {
+    return absl::InvalidArgumentError(absl::StrCat("a batch may hold at most 2^28 observations, got ",
+                                                   batch.observation_count()));
+  }
+  if (patch_cells > 0) {
+    if (map.kind != MapKind::kGrid) return absl::InvalidArgumentError("patch is only for grid maps");
+    static constexpr const char* kAxes[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) {
+      if (uint64_t{patch.origin[a]} + patch.size[a] > map.grid.size[a]) {
+        return absl::OutOfRangeError(absl::StrCat("patch along ", kAxes[a], " covers cells ", patch.origin[a], "..",
+                                                  uint64_t{patch.origin[a]} + patch.size[a] - 1,
+                                                  ", outside the grid's 0..", map.grid.size[a] - 1));
+      }
+    }
+  }
+  if (!batch.labels.empty() && map.kind != MapKind::kGeneric) {
+    return absl::InvalidArgumentError("labels (names and groups) are only for generic maps");
+  }
+  for (size_t i = 0; i < batch.labels.size(); ++i) {
+    if (batch.labels[i].name.size() > kMaxLabelLength || batch.labels[i].group.size() > kMaxLabelLength) {
+      return absl::InvalidArgumentError(absl::StrCat("labels[", i, "]: name and group may be at most 256 bytes"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector<uint8_t>& accept) {
+  BatchAck ack;
+  ack.sequence = batch.sequence;
+  accept.assign(batch.observation_count(), 1);
+  const auto reject = [&](size_t i, RejectReason reason) {
+    accept[i] = 0;
+    ++ack.rejected;
+    if (ack.rejections.size() < kMaxReportedRejections) ack.rejections.push_back({static_cast<uint32_t>(i), reason});
+  };
+  for (size_t i = 0; i < batch.keys.size(); ++i) {
+    if (!ValueOk(batch.values[i])) {
+      reject(i, RejectReason::kValueOutOfRange);
+    } else if (map.kind == MapKind::kGrid) {
+      const auto cell = MortonCell(batch.keys[i]);
+      if (MortonKey(cell[0], cell[1], cell[2]) != batch.keys[i] || !map.grid.Contains(cell[0], cell[1], cell[2])) {
+        reject(i, RejectReason::kOutsideMap);
+      }
+    }
+  }
+  for (size_t j = 0; j < batch.patch.values.size(); ++j) {
+    if (!ValueOk(batch.patch.values[j])) reject(batch.keys.size() + j, RejectReason::kValueOutOfRange);
+  }
+  ack.accepted = accept.size() - ack.rejected;
+  return ack;
+}
+
+// Layout (version 1): version u8 | writer varint | sequence varint | time f64 |
+// key count varint | keys (delta-zigzag varints: scans are spatially sorted, so deltas are small) |
+// values f32 each | patch origin 3×varint | patch size 3×varint | patch values f32 each |
+// label count varint | labels (key varint, name, group as length-prefixed bytes).
+std::string EncodeBatch(const ObservationBatch& batch) {
+  std::string out;
+  out.reserve(32 + batch.keys.size() * 7 + batch.observation_count() * 4);
+  out.push_back(static_cast<char>(kBatchVersion));
+  model::PutVarint64(&out, batch.writer_id);
+  model::PutVarint64(&out, batch.sequence);
+  model::PutDouble(&out, batch.time);
+  model::PutVarint64(&out, batch.keys.size());
+  uint64_t previous = 0;
+  for (uint64_t key : batch.keys) {
+    model::PutVarint64(&out, model::ZigZagEncode64(static_cast<int64_t>(key - previous)));
+    previous = key;
+  }
+  for (float v : batch.values) model::PutFloat(&out, v);
+  for (uint32_t o : batch.patch.origin) model::PutVarint64(&out, o);
+  for (uint32_t s : batch.patch.size) model::PutVarint64(&out, s);
+  for (float v : batch.patch.values) model::PutFloat(&out, v);
+  model::PutVarint64(&out, batch.labels.size());
+  for (const StateLabel& label : batch.labels) {
+    model::PutVarint64(&out, label.key);
+    model::PutVarint64(&out, label.name.size());
+    out += label.name;
+    model::PutVarint64(&out, label.group.size());
+    out += label.group;
+  }
+  return out;
+}
+
+absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes) {
+  model::ByteReader r(bytes, "batch");
+  ObservationBatch batch;
+  if (const uint8_t version = r.Byte("version"); r.ok() && version != kBatchVersion) {
+    r.Fail("version", absl::StrCat("unknown version ", version));
+  }
+  batch.writer_id = r.Varint("writer_id");
+  batch.sequence = r.Varint("sequence");
+  batch.time = r.Double("time");
+  const uint64_t key_count = r.Varint("key count");
+  // Each key takes at least one byte and its value four: a count beyond that is corruption.
+  if (r.ok() && key_count * 5 > r.remaining()) r.Fail("key count", "more than the bytes left");
+  batch.keys.resize(r.ok() ? key_count : 0);
+  uint64_t previous = 0;
+  for (uint64_t& key : batch.keys) {
+    key = previous + static_cast<uint64_t>(model::ZigZagDecode64(r.Varint("key")));
+    previous = key;
+  }
+  batch.values.resize(batch.keys.size());
+  for (float& v : batch.values) v = r.Float("value");
+  for (uint32_t& o : batch.patch.origin) o = static_cast<uint32_t>(r.Varint("patch.origin"));
+  uint64_t cells = 1;
+  for (uint32_t& s : batch.patch.size) {
+    const uint64_t v = r.Varint("patch.size");
+    if (r.ok() && v > kMaxGridIndex + 1) r.Fail("patch.size", "larger than a grid side");
+    s = static_cast<uint32_t>(v);
+    cells *= s;
+  }
+  if (r.ok() && cells * 4 > r.remaining()) r.Fail("patch.size", "more cells than the bytes left");
+  batch.patch.values.resize(r.ok() ? cells : 0);
+  for (float& v : batch.patch.values) v = r.Float("patch.value");
+  const uint64_t label_count = r.Varint("label count");
+  if (r.ok() && label_count * 3 > r.remaining()) r.Fail("label count", "more than the bytes left");
+  for (uint64_t i = 0; r.ok() && i < label_count; ++i) {
+    StateLabel label;
+    label.key = r.Varint("label.key");
+    const uint64_t name_length = r.Varint("label.name length");
+    if (r.ok() && name_length > kMaxLabelLength) r.Fail("label.name length", "longer than 256");
+    label.name = std::string(r.Bytes(r.ok() ? name_length : 0, "label.name"));
+    const uint64_t group_length = r.Varint("label.group length");
+    if (r.ok() && group_length > kMaxLabelLength) r.Fail("label.group length", "longer than 256");
+    label.group = std::string(r.Bytes(r.ok() ? group_length : 0, "label.group"));
+    batch.labels.push_back(std::move(label));
+  }
+  if (absl::Status s = r.Finish(); !s.ok()) return s;
+  if (batch.observation_count() > kMaxBatchObservations) return absl::DataLossError("batch: too many observations");
+  return batch;
+}
+
+}  // namespace fremen::storage

@@ -1,0 +1,88 @@
+// A batch of observations: one time, many states (one robot scan), from one writer with a sequence
+// number. The unit of the write path: validated, logged, applied and acknowledged whole.
+//
+// States are given by key (storage/cell_key.h: Morton code of a grid cell, or a generic state's id)
+// or, for grids, as a dense patch (a box of cells, values x fastest, then y, then z). Generic states
+// may be labelled with a name and a group in the batch that first mentions them.
+// Value types.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "storage/map_info.h"
+
+namespace fremen::storage {
+
+struct DensePatch {
+  std::array<uint32_t, 3> origin = {0, 0, 0};  // first cell
+  std::array<uint32_t, 3> size = {0, 0, 0};    // cells along x, y, z
+  std::vector<float> values;                   // size x·y·z, x fastest
+  bool operator==(const DensePatch&) const = default;
+};
+
+struct StateLabel {
+  uint64_t key = 0;
+  std::string name;   // may be empty
+  std::string group;  // may be empty
+  bool operator==(const StateLabel&) const = default;
+};
+
+struct ObservationBatch {
+  // Who sent it and its place in that writer's sequence: a batch whose (writer, sequence) was
+  // already applied is acknowledged again, not applied again.
+  uint64_t writer_id = 0;
+  uint64_t sequence = 0;
+  double time = 0;
+  std::vector<uint64_t> keys;
+  std::vector<float> values;  // one per key
+  DensePatch patch;           // empty when size has a zero
+  std::vector<StateLabel> labels;
+
+  size_t observation_count() const {
+    return keys.size() + size_t{patch.size[0]} * patch.size[1] * patch.size[2];
+  }
+  bool operator==(const ObservationBatch&) const = default;
+};
+
+// Why an observation was not applied.
+enum class RejectReason : uint8_t {
+  kValueOutOfRange = 1,  // NaN or outside [0, 1]
+  kOutsideMap = 2,       // a cell outside the grid
+};
+
+struct Rejection {
+  uint32_t index;  // position in keys, then in the patch (keys.size() + patch offset)
+  RejectReason reason;
+};
+
+struct BatchAck {
+  uint64_t sequence = 0;
+  uint64_t accepted = 0;
+  uint64_t rejected = 0;
+  // The first rejections (at most kMaxReportedRejections), for the client to fix its input.
+  std::vector<Rejection> rejections;
+  // The batch had been applied before (a retry): nothing was applied this time.
+  bool duplicate = false;
+  uint64_t lsn = 0;  // its place in the map's log
+};
+
+inline constexpr size_t kMaxReportedRejections = 16;
+
+// Checks what makes the whole batch unusable (the message names the field): the time (finite,
+// within ±1e13 s), mismatched lengths, a patch outside the grid or with the wrong value count,
+// labels on a grid. Per-observation problems are not errors: see Classify.
+absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch);
+
+// Marks each observation accepted or rejected; `accept[i]` for i over keys then patch cells.
+BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector<uint8_t>& accept);
+
+// Log payload encoding. Decode answers DataLoss on damaged bytes.
+std::string EncodeBatch(const ObservationBatch& batch);
+absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes);
+
+}  // namespace fremen::storage

@@ -1,0 +1,97 @@
+#include "storage/batch.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "storage/cell_key.h"
+
+namespace fremen::storage {
+namespace {
+
+MapInfo Grid() {
+  MapInfo info;
+  info.name = "g";
+  info.grid.size = {10, 10, 1};
+  return info;
+}
+
+ObservationBatch Scan() {
+  ObservationBatch batch;
+  batch.writer_id = 7;
+  batch.sequence = 99;
+  batch.time = 1.7e9 + 0.25;
+  for (uint32_t x = 0; x < 5; ++x) {
+    batch.keys.push_back(MortonKey(x, 2, 0));
+    batch.values.push_back(x % 2 ? 1.0f : 0.0f);
+  }
+  batch.patch.origin = {1, 1, 0};
+  batch.patch.size = {2, 3, 1};
+  batch.patch.values = {0, 1, 0.5f, 1, 0, 1};
+  return batch;
+}
+
+TEST(BatchTest, EncodingRoundTrips) {
+  ObservationBatch batch = Scan();
+  batch.keys.push_back(3);  // a key below the previous: negative delta
+  batch.values.push_back(1);
+  batch.labels.push_back({3, "kitchen door", "kitchen"});
+  auto decoded = DecodeBatch(EncodeBatch(batch));
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ(*decoded, batch);
+}
+
+TEST(BatchTest, WholeBatchProblemsNameTheField) {
+  const MapInfo map = Grid();
+  ObservationBatch batch = Scan();
+  batch.time = NAN;
+  EXPECT_NE(ValidateBatch(map, batch).message().find("time"), std::string::npos);
+  batch = Scan();
+  batch.values.pop_back();
+  EXPECT_NE(ValidateBatch(map, batch).message().find("values"), std::string::npos);
+  batch = Scan();
+  batch.patch.origin = {9, 0, 0};
+  EXPECT_TRUE(absl::IsOutOfRange(ValidateBatch(map, batch)));
+  batch = Scan();
+  batch.patch.values.pop_back();
+  EXPECT_NE(ValidateBatch(map, batch).message().find("patch.values"), std::string::npos);
+  batch = Scan();
+  batch.labels.push_back({1, "x", ""});
+  EXPECT_NE(ValidateBatch(map, batch).message().find("labels"), std::string::npos);
+  EXPECT_TRUE(ValidateBatch(map, Scan()).ok());
+}
+
+TEST(BatchTest, BadObservationsAreRejectedOneByOneWithReasons) {
+  const MapInfo map = Grid();
+  ObservationBatch batch = Scan();
+  batch.values[1] = 1.5f;
+  batch.keys[3] = MortonKey(12, 0, 0);  // x outside the 10-cell grid
+  batch.patch.values[4] = NAN;
+  std::vector<uint8_t> accept;
+  const BatchAck ack = Classify(map, batch, accept);
+  EXPECT_EQ(ack.accepted, 8u);
+  EXPECT_EQ(ack.rejected, 3u);
+  ASSERT_EQ(ack.rejections.size(), 3u);
+  EXPECT_EQ(ack.rejections[0].index, 1u);
+  EXPECT_EQ(ack.rejections[0].reason, RejectReason::kValueOutOfRange);
+  EXPECT_EQ(ack.rejections[1].index, 3u);
+  EXPECT_EQ(ack.rejections[1].reason, RejectReason::kOutsideMap);
+  EXPECT_EQ(ack.rejections[2].index, 5u + 4u);
+  EXPECT_EQ(accept[9], 0);
+  EXPECT_EQ(accept[0], 1);
+}
+
+TEST(BatchTest, DamagedBytesAreDataLossNeverACrash) {
+  ObservationBatch with_label = Scan();
+  const std::string good = EncodeBatch(with_label);
+  for (size_t n = 0; n < good.size(); ++n) EXPECT_FALSE(DecodeBatch(good.substr(0, n)).ok()) << n;
+  std::mt19937 rng(5);
+  for (int i = 0; i < 5000; ++i) {
+    std::string bytes = good;
+    for (int flips = 0; flips < 3; ++flips) bytes[rng() % bytes.size()] ^= static_cast<char>(1 << (rng() % 8));
+    (void)DecodeBatch(bytes);  // must not crash or over-allocate (ASan build)
+  }
+}
+
+}  // namespace
+}  // namespace fremen::storage

@@ -1,0 +1,49 @@
+// The catalog of maps: name → MapInfo, in its own LMDB environment (<data dir>/catalog).
+//
+// Create assigns the map's id (never reused), its creation time and its default shard count; names
+// are unique. Deleting a map removes only its entry: the Store removes the map's files after, and
+// removes at start any map directory the catalog does not know (a crash between the two).
+// Thread-safety: all methods may be called concurrently (LMDB serialises the writers).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "storage/lmdb/lmdb_env.h"
+#include "storage/map_info.h"
+
+namespace fremen::storage {
+
+struct MapPage {
+  std::vector<MapInfo> maps;
+  // Pass to the next List call; empty on the last page.
+  std::string next_page_token;
+};
+
+inline constexpr size_t kMaxPageSize = 1000;
+inline constexpr size_t kDefaultPageSize = 100;
+
+class Catalog {
+ public:
+  static absl::StatusOr<std::unique_ptr<Catalog>> Open(const std::string& dir);
+
+  // InvalidArgument naming the bad field, AlreadyExists for a taken name.
+  // `default_shards` fills in info.shards when it is 0.
+  absl::StatusOr<MapInfo> Create(MapInfo info, uint32_t default_shards);
+  // NotFound when no map has that name.
+  absl::StatusOr<MapInfo> Get(const std::string& name) const;
+  // Maps in name order. page_size 0 = the default (100); at most 1000. The token is opaque.
+  absl::StatusOr<MapPage> List(size_t page_size, const std::string& page_token) const;
+  // NotFound when no map has that name.
+  absl::Status Delete(const std::string& name);
+  // Puts a map back under its own id (restore from a backup). AlreadyExists for a taken name.
+  absl::Status Restore(const MapInfo& info);
+
+ private:
+  explicit Catalog(std::unique_ptr<LmdbEnv> env) : env_(std::move(env)) {}
+  std::unique_ptr<LmdbEnv> env_;
+};
+
+}  // namespace fremen::storage

@@ -1,0 +1,83 @@
+#include "storage/map_info.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace fremen::storage {
+namespace {
+
+MapInfo Office() {
+  MapInfo info;
+  info.name = "office-3d";
+  info.id = 42;
+  info.grid.resolution = 0.1;
+  info.grid.origin = {-5, -5, 0};
+  info.grid.size = {100, 100, 20};
+  info.shards = 2;
+  info.created_unix = 1700000000;
+  return info;
+}
+
+TEST(MapInfoTest, EncodingRoundTrips) {
+  MapInfo info = Office();
+  info.periods.explicit_periods = {86400, 43200};
+  info.lossless_sampling_period = 5;
+  auto decoded = DecodeMapInfo(EncodeMapInfo(info));
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ(*decoded, info);
+}
+
+TEST(MapInfoTest, ValidationNamesTheField) {
+  const auto message_of = [](MapInfo info) { return std::string(ValidateMapInfo(info).message()); };
+  MapInfo bad = Office();
+  bad.name = "no spaces";
+  EXPECT_NE(message_of(bad).find("name"), std::string::npos);
+  bad = Office();
+  bad.grid.resolution = -1;
+  EXPECT_NE(message_of(bad).find("grid.resolution"), std::string::npos);
+  bad = Office();
+  bad.grid.size[2] = 0;
+  EXPECT_NE(message_of(bad).find("grid.size.z"), std::string::npos);
+  bad = Office();
+  bad.max_order = 65;
+  EXPECT_NE(message_of(bad).find("max_order"), std::string::npos);
+  bad = Office();
+  bad.periods.count = 0;
+  EXPECT_NE(message_of(bad).find("periods"), std::string::npos);
+  bad = Office();
+  bad.error_half_life = NAN;
+  EXPECT_NE(message_of(bad).find("error_half_life"), std::string::npos);
+  EXPECT_TRUE(ValidateMapInfo(Office()).ok());
+}
+
+TEST(MapInfoTest, CellOfAPoint) {
+  const MapInfo info = Office();
+  const auto cell = info.grid.CellOf(0.05, -4.95, 1.99);
+  ASSERT_TRUE(cell.has_value());
+  EXPECT_EQ((*cell)[0], 50u);
+  EXPECT_EQ((*cell)[1], 0u);
+  EXPECT_EQ((*cell)[2], 19u);
+  EXPECT_FALSE(info.grid.CellOf(-5.01, 0, 0).has_value());
+  EXPECT_FALSE(info.grid.CellOf(0, 0, 2.0).has_value());
+  EXPECT_FALSE(info.grid.CellOf(NAN, 0, 0).has_value());
+}
+
+TEST(MapInfoTest, DamagedBytesAreDataLossNeverACrash) {
+  const std::string good = EncodeMapInfo(Office());
+  for (size_t n = 0; n < good.size(); ++n) {
+    EXPECT_TRUE(absl::IsDataLoss(DecodeMapInfo(good.substr(0, n)).status())) << n;
+  }
+  std::mt19937 rng(3);
+  for (int i = 0; i < 3000; ++i) {
+    std::string bytes = good;
+    bytes[rng() % bytes.size()] ^= static_cast<char>(1 << (rng() % 8));
+    auto decoded = DecodeMapInfo(bytes);
+    if (decoded.ok()) {
+      EXPECT_TRUE(ValidateMapInfo(*decoded).ok());
+    }
+  }
+}
+
+}  // namespace
+}  // namespace fremen::storage
