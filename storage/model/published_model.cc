@@ -14,6 +14,14 @@ PublishedModel PublishedModel::MeanOnly(double alpha0) {
   return model;
 }
 
+PublishedModel PublishedModel::Restore(float alpha0, int order, std::vector<Component> components) {
+  PublishedModel model;
+  model.alpha0_ = alpha0;
+  model.order_ = static_cast<uint8_t>(order);
+  model.components_ = std::move(components);
+  return model;
+}
+
 PublishedModel PublishedModel::FromGammas(double gamma0, const std::vector<std::complex<double>>& gammas,
                                           const PeriodSet& periods, double span, int max_order, int order) {
   PublishedModel model = MeanOnly(gamma0);

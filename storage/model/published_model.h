@@ -36,6 +36,8 @@ class PublishedModel {
   PublishedModel() = default;
   // A model with only a mean: what a state predicts before its first publication.
   static PublishedModel MeanOnly(double alpha0);
+  // A model from its stored parts (decoders). REQUIRES: components sorted by amplitude.
+  static PublishedModel Restore(float alpha0, int order, std::vector<Component> components);
 
   // The top-`max_order` eligible components of `spectrum` by amplitude, with selected order
   // `order` (REQUIRES: 0 <= order <= max_order).

@@ -50,7 +50,6 @@ void StaticState::Promote(const ModelSettings& settings, BasicStateModel<Real>& 
   persistence.t_last = t_last();
   persistence.s_last = value();
   persistence.samples = count() - 1;
-  out.set_published(PublishedModel::MeanOnly(value()));
 }
 
 template void StaticState::Promote(const ModelSettings&, BasicStateModel<float>&) const;

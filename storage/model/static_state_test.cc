@@ -28,7 +28,6 @@ TEST(StaticStateTest, PromotionOfARegularlySampledStateEqualsTheFullModel) {
     compact.Observe(t, 0);
     full.Observe(t, 0);
   }
-  full.Publish(0);
   StateModel promoted(settings);
   compact.Promote(settings, promoted);
   // The change arrives: both models must agree from here on.
@@ -42,6 +41,8 @@ TEST(StaticStateTest, PromotionOfARegularlySampledStateEqualsTheFullModel) {
   EXPECT_EQ(promoted.persistence().s_last, full.persistence().s_last);
   EXPECT_NEAR(promoted.persistence().inv_tau, full.persistence().inv_tau, 1e-9);
   EXPECT_EQ(promoted.order_errors().errors(), full.order_errors().errors());
+  EXPECT_EQ(promoted.has_published(), full.has_published());
+  EXPECT_NEAR(promoted.Predict(compact.t_last()), full.Predict(compact.t_last()), 1e-9);
 }
 
 }  // namespace

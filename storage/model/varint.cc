@@ -1,0 +1,151 @@
+#include "storage/model/varint.h"
+
+#include <bit>
+
+#include "absl/strings/str_cat.h"
+
+namespace fremen::model {
+
+namespace {
+
+// Decodes one varint from p[0, size). Returns the bytes consumed, or 0 with *problem set.
+size_t DecodeVarint(const unsigned char* p, size_t size, uint64_t* value, const char** problem) {
+  uint64_t v = 0;
+  for (size_t i = 0; i < kMaxVarint64Bytes; ++i) {
+    if (i == size) {
+      *problem = "truncated varint";
+      return 0;
+    }
+    const unsigned char b = p[i];
+    // The 10th byte holds only bit 63: anything more does not fit in 64 bits.
+    if (i == kMaxVarint64Bytes - 1 && b > 1) {
+      *problem = "overlong varint (more than 64 bits)";
+      return 0;
+    }
+    v |= static_cast<uint64_t>(b & 0x7f) << (7 * i);
+    if ((b & 0x80) == 0) {
+      if (i > 0 && b == 0) {
+        *problem = "non-canonical varint (redundant zero byte)";
+        return 0;
+      }
+      *value = v;
+      return i + 1;
+    }
+  }
+  *problem = "overlong varint (more than 64 bits)";  // unreachable: the 10th byte check returns first
+  return 0;
+}
+
+template <typename T>
+T LoadLittleEndian(const char* p) {
+  T v = 0;
+  for (size_t i = 0; i < sizeof(T); ++i) v |= static_cast<T>(static_cast<unsigned char>(p[i])) << (8 * i);
+  return v;
+}
+
+template <typename T>
+void AppendLittleEndian(std::string* out, T v) {
+  char bytes[sizeof(T)];
+  for (size_t i = 0; i < sizeof(T); ++i) bytes[i] = static_cast<char>(v >> (8 * i));
+  out->append(bytes, sizeof(T));
+}
+
+}  // namespace
+
+void PutVarint64(std::string* out, uint64_t v) {
+  char buf[kMaxVarint64Bytes];
+  size_t n = 0;
+  while (v >= 0x80) {
+    buf[n++] = static_cast<char>(v | 0x80);
+    v >>= 7;
+  }
+  buf[n++] = static_cast<char>(v);
+  out->append(buf, n);
+}
+
+size_t Varint64Length(uint64_t v) {
+  // 7 payload bits per byte; 0 still takes one byte.
+  const int bits = std::bit_width(v | 1);
+  return static_cast<size_t>((bits + 6) / 7);
+}
+
+absl::StatusOr<uint64_t> GetVarint64(std::string_view* in) {
+  uint64_t v = 0;
+  const char* problem = nullptr;
+  const size_t n = DecodeVarint(reinterpret_cast<const unsigned char*>(in->data()), in->size(), &v, &problem);
+  if (n == 0) return absl::DataLossError(problem);
+  in->remove_prefix(n);
+  return v;
+}
+
+void PutFixed32(std::string* out, uint32_t v) { AppendLittleEndian(out, v); }
+void PutFixed64(std::string* out, uint64_t v) { AppendLittleEndian(out, v); }
+void PutFloat(std::string* out, float v) { PutFixed32(out, std::bit_cast<uint32_t>(v)); }
+void PutDouble(std::string* out, double v) { PutFixed64(out, std::bit_cast<uint64_t>(v)); }
+
+bool ByteReader::Need(size_t n, std::string_view field) {
+  if (!ok()) return false;
+  if (n > remaining()) {
+    Fail(field, absl::StrCat("truncated: needs ", n, " bytes, ", remaining(), " left"));
+    return false;
+  }
+  return true;
+}
+
+void ByteReader::Fail(std::string_view field, std::string_view problem) {
+  if (!ok()) return;
+  // std::string_view is not absl::string_view in this abseil build: StrCat cannot take the views.
+  std::string message(record_);
+  message.append(": ").append(field).append(": ").append(problem);
+  status_ = absl::DataLossError(absl::StrCat(message, " (at byte ", offset_, ")"));
+}
+
+uint64_t ByteReader::Varint(std::string_view field) {
+  if (!ok()) return 0;
+  uint64_t v = 0;
+  const char* problem = nullptr;
+  const size_t n =
+      DecodeVarint(reinterpret_cast<const unsigned char*>(bytes_.data() + offset_), remaining(), &v, &problem);
+  if (n == 0) {
+    Fail(field, problem);
+    return 0;
+  }
+  offset_ += n;
+  return v;
+}
+
+uint8_t ByteReader::Byte(std::string_view field) {
+  if (!Need(1, field)) return 0;
+  return static_cast<uint8_t>(bytes_[offset_++]);
+}
+
+uint32_t ByteReader::Fixed32(std::string_view field) {
+  if (!Need(4, field)) return 0;
+  const uint32_t v = LoadLittleEndian<uint32_t>(bytes_.data() + offset_);
+  offset_ += 4;
+  return v;
+}
+
+uint64_t ByteReader::Fixed64(std::string_view field) {
+  if (!Need(8, field)) return 0;
+  const uint64_t v = LoadLittleEndian<uint64_t>(bytes_.data() + offset_);
+  offset_ += 8;
+  return v;
+}
+
+float ByteReader::Float(std::string_view field) { return std::bit_cast<float>(Fixed32(field)); }
+double ByteReader::Double(std::string_view field) { return std::bit_cast<double>(Fixed64(field)); }
+
+std::string_view ByteReader::Bytes(uint64_t n, std::string_view field) {
+  if (!Need(n, field)) return {};
+  const std::string_view v = bytes_.substr(offset_, n);
+  offset_ += n;
+  return v;
+}
+
+absl::Status ByteReader::Finish() {
+  if (ok() && remaining() > 0) Fail("end", absl::StrCat(remaining(), " unexpected trailing bytes"));
+  return status_;
+}
+
+}  // namespace fremen::model

@@ -1,0 +1,81 @@
+// Byte coding of the model records: LEB128 varints, zigzag, little-endian fixed-width values, and a
+// bounds-checked reader for decoding bytes that may be truncated or corrupted.
+//
+// Varints are canonical: the shortest encoding of a value is the only one accepted, so a decoded
+// record re-encodes to the same bytes and a corrupted continuation bit cannot hide as a valid value.
+// Thread-safety: free functions are pure; a ByteReader is a cursor owned by one decoder.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+
+namespace fremen::model {
+
+inline constexpr size_t kMaxVarint64Bytes = 10;
+
+// Appends the LEB128 encoding of v (7 bits per byte, low bits first, high bit = more bytes follow).
+void PutVarint64(std::string* out, uint64_t v);
+// The encoded length of v in bytes (1..10).
+size_t Varint64Length(uint64_t v);
+// Reads a varint from the front of *in and advances past it. DataLoss on truncated, overlong (more
+// than 64 bits) or non-canonical (redundant trailing zero byte) input; *in is unchanged on error.
+absl::StatusOr<uint64_t> GetVarint64(std::string_view* in);
+
+// Zigzag maps signed to unsigned so that small magnitudes of either sign get short varints.
+inline uint64_t ZigZagEncode64(int64_t v) {
+  return (static_cast<uint64_t>(v) << 1) ^ static_cast<uint64_t>(v >> 63);
+}
+inline int64_t ZigZagDecode64(uint64_t v) { return static_cast<int64_t>(v >> 1) ^ -static_cast<int64_t>(v & 1); }
+
+// Little-endian fixed-width values; float and double by their IEEE-754 bit patterns.
+void PutFixed32(std::string* out, uint32_t v);
+void PutFixed64(std::string* out, uint64_t v);
+void PutFloat(std::string* out, float v);
+void PutDouble(std::string* out, double v);
+
+// Reads a record front to back. Every read checks the remaining length first. The first failure is
+// sticky: it is kept as a DataLoss status naming the record, the field and the byte offset, and every
+// later read returns 0 without reading, so a decoder can read a group of fields and check ok() once
+// before using them.
+class ByteReader {
+ public:
+  // `record` names what is decoded in error messages, e.g. "lossless history".
+  ByteReader(std::string_view bytes, std::string_view record) : bytes_(bytes), record_(record) {}
+
+  uint64_t Varint(std::string_view field);
+  uint8_t Byte(std::string_view field);
+  uint32_t Fixed32(std::string_view field);
+  uint64_t Fixed64(std::string_view field);
+  float Float(std::string_view field);
+  double Double(std::string_view field);
+  // The next n bytes, as a view into the input.
+  std::string_view Bytes(uint64_t n, std::string_view field);
+
+  // Records a semantic error found by the decoder (e.g. a value out of range) at the current offset.
+  // Keeps the first error only.
+  void Fail(std::string_view field, std::string_view problem);
+
+  bool ok() const { return status_.ok(); }
+  const absl::Status& status() const { return status_; }
+  size_t offset() const { return offset_; }
+  size_t remaining() const { return bytes_.size() - offset_; }
+  // The bytes read from `offset` up to the current offset.
+  std::string_view Since(size_t offset) const { return bytes_.substr(offset, offset_ - offset); }
+  // OK when everything was read without error; DataLoss when bytes are left over.
+  absl::Status Finish();
+
+ private:
+  bool Need(size_t n, std::string_view field);
+
+  std::string_view bytes_;
+  std::string_view record_;
+  size_t offset_ = 0;
+  absl::Status status_;
+};
+
+}  // namespace fremen::model
