@@ -1,0 +1,459 @@
+#include "storage/map_store.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <future>
+
+#include "absl/strings/str_cat.h"
+#include "storage/cell_key.h"
+
+namespace fremen::storage {
+
+namespace {
+
+// The first byte of a log record: what it holds.
+constexpr char kBatchRecord = 'B';    // an ObservationBatch follows
+constexpr char kPublishRecord = 'P';  // every shard republished its models here
+
+std::string ShardDir(const std::string& dir, uint32_t i) { return absl::StrCat(dir, "/shard-", i); }
+
+absl::Status MakeDir(const std::string& dir) {
+  if (mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) {
+    return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", std::strerror(errno)));
+  }
+  return absl::OkStatus();
+}
+
+// Runs f(shard) for every shard, in parallel threads when the work is big enough to pay for them.
+void ForEachShardInParallel(size_t shards, bool parallel, const std::function<void(size_t)>& f) {
+  if (!parallel || shards == 1) {
+    for (size_t s = 0; s < shards; ++s) f(s);
+    return;
+  }
+  std::vector<std::thread> threads;
+  for (size_t s = 1; s < shards; ++s) threads.emplace_back(f, s);
+  f(0);
+  for (std::thread& t : threads) t.join();
+}
+
+}  // namespace
+
+MapStore::MapStore(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings)
+    : info_(std::move(info)), dir_(std::move(dir)), options_(options), settings_(std::move(settings)) {}
+
+absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const MapInfo& info, const std::string& dir,
+                                                         const StoreOptions& options) {
+  if (absl::Status valid = ValidateMapInfo(info); !valid.ok()) return valid;
+  if (info.shards == 0) return absl::InvalidArgumentError("shards must be set before a map is opened");
+  auto settings = ModelSettingsOf(info);
+  if (!settings.ok()) return settings.status();
+  if (absl::Status s = MakeDir(dir); !s.ok()) return s;
+  auto store = std::unique_ptr<MapStore>(
+      new MapStore(info, dir, options, std::make_unique<model::ModelSettings>(*std::move(settings))));
+  LmdbOptions lmdb;
+  lmdb.initial_map_size = options.initial_map_size;
+  for (uint32_t i = 0; i < info.shards; ++i) {
+    auto shard = Shard::Open(store->info_, *store->settings_, ShardDir(dir, i), lmdb);
+    if (!shard.ok()) {
+      return absl::Status(shard.status().code(), absl::StrCat("map ", info.name, " shard ", i, ": ",
+                                                              shard.status().message()));
+    }
+    store->shards_.push_back(*std::move(shard));
+  }
+  if (absl::Status s = store->Recover(); !s.ok()) {
+    return absl::Status(s.code(), absl::StrCat("map ", info.name, ": recovery: ", s.message()));
+  }
+  store->workers_ = std::make_unique<ShardWorkers>(info.shards, "fremen-shard");
+  store->committer_ = std::thread([s = store.get()] { s->CommitLoop(); });
+  return store;
+}
+
+MapStore::~MapStore() { (void)Close(); }
+
+absl::Status MapStore::Recover() {
+  uint64_t from = UINT64_MAX;
+  for (const auto& shard : shards_) {
+    from = std::min(from, shard->checkpoint_lsn());
+    dedup_.MergeFrom(shard->checkpoint_dedup());
+  }
+  std::vector<std::vector<uint64_t>> keys;
+  std::vector<std::vector<float>> values;
+  auto replayed = ReplayWal(dir_ + "/wal", from, [&](uint64_t lsn, std::span<const uint8_t> payload) -> absl::Status {
+    if (payload.size() == 1 && payload[0] == kPublishRecord) {
+      for (const auto& shard : shards_) {
+        if (shard->checkpoint_lsn() < lsn) shard->PublishAll();
+      }
+      return absl::OkStatus();
+    }
+    if (payload.empty() || payload[0] != kBatchRecord) {
+      return absl::DataLossError(absl::StrCat("log record ", lsn, ": unknown record kind"));
+    }
+    auto batch = DecodeBatch({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1});
+    if (!batch.ok()) return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", batch.status().message()));
+    dedup_.Record(batch->writer_id, batch->sequence);
+    Pending pending{*std::move(batch), nullptr, {}, {}};
+    pending.ack = Classify(info_, pending.batch, pending.accept);
+    SplitByShard(pending, keys, values);
+    const ScanContext scan(settings_->periods, pending.batch.time);
+    for (uint32_t s = 0; s < shards_.size(); ++s) {
+      if (shards_[s]->checkpoint_lsn() >= lsn) continue;  // the checkpoint has it already
+      shards_[s]->Apply(scan, keys[s], values[s]);
+      std::vector<StateLabel> mine;
+      for (const StateLabel& l : pending.batch.labels) {
+        if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);
+      }
+      shards_[s]->ApplyLabels(mine);
+    }
+    return absl::OkStatus();
+  });
+  if (!replayed.ok()) return replayed.status();
+  WalOptions wal_options;
+  wal_options.segment_bytes = options_.log_segment_bytes;
+  auto wal = WalWriter::Open(dir_ + "/wal", wal_options);
+  if (!wal.ok()) return wal.status();
+  wal_ = *std::move(wal);
+  for (const auto& shard : shards_) {
+    shard->ForEachLabel([&](uint64_t key, const std::string&, const std::string& group) {
+      if (!group.empty()) groups_[group].push_back(key);
+    });
+  }
+  return absl::OkStatus();
+}
+
+void MapStore::SplitByShard(const Pending& pending, std::vector<std::vector<uint64_t>>& keys,
+                            std::vector<std::vector<float>>& values) const {
+  keys.resize(info_.shards);
+  values.resize(info_.shards);
+  for (uint32_t s = 0; s < info_.shards; ++s) {
+    keys[s].clear();
+    values[s].clear();
+  }
+  const ObservationBatch& b = pending.batch;
+  for (size_t i = 0; i < b.keys.size(); ++i) {
+    if (!pending.accept[i]) continue;
+    const uint32_t s = ShardOf(b.keys[i], info_.shards);
+    keys[s].push_back(b.keys[i]);
+    values[s].push_back(b.values[i]);
+  }
+  const DensePatch& p = b.patch;
+  size_t j = b.keys.size();
+  for (uint32_t z = 0; z < p.size[2]; ++z) {
+    for (uint32_t y = 0; y < p.size[1]; ++y) {
+      for (uint32_t x = 0; x < p.size[0]; ++x, ++j) {
+        if (!pending.accept[j]) continue;
+        const uint64_t key = MortonKey(p.origin[0] + x, p.origin[1] + y, p.origin[2] + z);
+        const uint32_t s = ShardOf(key, info_.shards);
+        keys[s].push_back(key);
+        values[s].push_back(p.values[j - b.keys.size()]);
+      }
+    }
+  }
+}
+
+absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
+  if (absl::Status valid = ValidateBatch(info_, batch); !valid.ok()) return valid;
+  if (info_.lossless_sampling_period > 0 && batch.time < info_.lossless_origin) {
+    return absl::InvalidArgumentError(absl::StrCat("time must not be before the map's lossless origin ",
+                                                   info_.lossless_origin, ", got ", batch.time));
+  }
+  Pending pending{std::move(batch), std::move(done), {}, {}};
+  pending.ack = Classify(info_, pending.batch, pending.accept);
+  const uint64_t n = pending.batch.observation_count();
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (closing_) return absl::UnavailableError(absl::StrCat("map ", info_.name, " is closing"));
+    if (!write_error_.ok()) return write_error_;
+    // One batch is always let in, however big, so that a single huge scan is not refused forever.
+    if (queued_observations_ > 0 && queued_observations_ + n > options_.max_queued_observations) {
+      return absl::ResourceExhaustedError(absl::StrCat("map ", info_.name,
+                                                       " is behind on ingest: too many queued observations; retry"));
+    }
+    queued_observations_ += n;
+    queue_.push_back(std::move(pending));
+  }
+  queue_ready_.notify_one();
+  return absl::OkStatus();
+}
+
+absl::StatusOr<BatchAck> MapStore::Write(ObservationBatch batch) {
+  std::promise<absl::StatusOr<BatchAck>> promise;
+  auto future = promise.get_future();
+  if (absl::Status s = Submit(std::move(batch), [&](absl::StatusOr<BatchAck> ack) { promise.set_value(std::move(ack)); });
+      !s.ok()) {
+    return s;
+  }
+  return future.get();
+}
+
+absl::StatusOr<uint64_t> MapStore::RunControl(Control::Kind kind) {
+  std::promise<absl::StatusOr<uint64_t>> promise;
+  auto future = promise.get_future();
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (!committer_.joinable() || closing_) return absl::UnavailableError(absl::StrCat("map ", info_.name, " is closed"));
+    controls_.push_back({kind, [&](absl::StatusOr<uint64_t> r) { promise.set_value(std::move(r)); }});
+  }
+  queue_ready_.notify_one();
+  return future.get();
+}
+
+absl::Status MapStore::Checkpoint() { return RunControl(Control::Kind::kCheckpoint).status(); }
+
+absl::StatusOr<uint64_t> MapStore::PublishModels() { return RunControl(Control::Kind::kPublish); }
+
+absl::Status MapStore::Close() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    closing_ = true;
+  }
+  queue_ready_.notify_one();
+  if (committer_.joinable()) committer_.join();
+  std::lock_guard lock(queue_mutex_);
+  return write_error_;
+}
+
+void MapStore::CommitLoop() {
+  for (;;) {
+    std::vector<Pending> group;
+    std::vector<Control> controls;
+    bool closing;
+    {
+      std::unique_lock lock(queue_mutex_);
+      queue_ready_.wait(lock, [&] { return !queue_.empty() || closing_ || !controls_.empty(); });
+      while (!queue_.empty()) {
+        queued_observations_ -= queue_.front().batch.observation_count();
+        group.push_back(std::move(queue_.front()));
+        queue_.pop_front();
+      }
+      controls.swap(controls_);
+      closing = closing_;
+    }
+    if (!group.empty()) CommitGroup(group);
+    for (Control& c : controls) {
+      if (c.kind == Control::Kind::kPublish) c.done(DoPublish());
+    }
+    const bool checkpoint_asked = std::any_of(controls.begin(), controls.end(),
+                                              [](const Control& c) { return c.kind == Control::Kind::kCheckpoint; });
+    if (checkpoint_asked || wal_->bytes() >= options_.checkpoint_log_bytes || (closing && group.empty())) {
+      const absl::Status status = DoCheckpoint();
+      for (Control& c : controls) {
+        if (c.kind == Control::Kind::kCheckpoint) c.done(status.ok() ? absl::StatusOr<uint64_t>(0) : status);
+      }
+    }
+    if (closing && group.empty()) return;
+  }
+}
+
+void MapStore::CommitGroup(std::vector<Pending>& group) {
+  absl::Status status;
+  {
+    std::lock_guard lock(queue_mutex_);
+    status = write_error_;
+  }
+  // 1. Log the new batches, then sync once for all of them.
+  if (status.ok()) {
+    for (Pending& p : group) {
+      if (dedup_.Seen(p.batch.writer_id, p.batch.sequence)) {
+        p.ack = BatchAck{};
+        p.ack.sequence = p.batch.sequence;
+        p.ack.duplicate = true;
+        continue;
+      }
+      dedup_.Record(p.batch.writer_id, p.batch.sequence);
+      std::string record(1, kBatchRecord);
+      record += EncodeBatch(p.batch);
+      p.ack.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(record.data()), record.size()});
+    }
+    status = wal_->Sync();
+  }
+  if (!status.ok()) {
+    {
+      std::lock_guard lock(queue_mutex_);
+      if (write_error_.ok()) write_error_ = status;
+    }
+    for (Pending& p : group) p.done(status);
+    return;
+  }
+  // 2. Every shard folds in its part of every batch, in batch order.
+  std::vector<const Pending*> fresh;
+  for (const Pending& p : group) {
+    if (!p.ack.duplicate) fresh.push_back(&p);
+  }
+  std::vector<ScanContext> scans;
+  scans.reserve(fresh.size());
+  std::vector<std::vector<std::vector<uint64_t>>> keys(fresh.size());
+  std::vector<std::vector<std::vector<float>>> values(fresh.size());
+  for (size_t b = 0; b < fresh.size(); ++b) {
+    scans.emplace_back(settings_->periods, fresh[b]->batch.time);
+    SplitByShard(*fresh[b], keys[b], values[b]);
+  }
+  workers_->RunOnAll([&](uint32_t s) {
+    for (size_t b = 0; b < fresh.size(); ++b) {
+      shards_[s]->Apply(scans[b], keys[b][s], values[b][s]);
+      std::vector<StateLabel> mine;
+      for (const StateLabel& l : fresh[b]->batch.labels) {
+        if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);
+      }
+      if (!mine.empty()) shards_[s]->ApplyLabels(mine);
+    }
+  });
+  for (const Pending* p : fresh) IndexLabels(p->batch.labels);
+  // 3. Durable and visible: acknowledge.
+  for (Pending& p : group) p.done(p.ack);
+}
+
+void MapStore::IndexLabels(std::span<const StateLabel> labels) {
+  if (labels.empty()) return;
+  std::lock_guard lock(groups_mutex_);
+  for (const StateLabel& l : labels) {
+    if (l.group.empty()) continue;
+    std::vector<uint64_t>& members = groups_[l.group];
+    if (std::find(members.begin(), members.end(), l.key) == members.end()) members.push_back(l.key);
+  }
+}
+
+absl::StatusOr<uint64_t> MapStore::DoPublish() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (!write_error_.ok()) return write_error_;
+  }
+  const char record[] = {kPublishRecord};
+  wal_->Append({reinterpret_cast<const uint8_t*>(record), 1});
+  if (absl::Status s = wal_->Sync(); !s.ok()) {
+    std::lock_guard lock(queue_mutex_);
+    if (write_error_.ok()) write_error_ = s;
+    return s;
+  }
+  std::vector<uint64_t> published(shards_.size());
+  workers_->RunOnAll([&](uint32_t s) { published[s] = shards_[s]->PublishAll(); });
+  uint64_t total = 0;
+  for (uint64_t n : published) total += n;
+  return total;
+}
+
+absl::Status MapStore::DoCheckpoint() {
+  std::lock_guard backup(backup_mutex_);
+  const uint64_t lsn = wal_->last_lsn();
+  std::vector<absl::Status> results(shards_.size());
+  workers_->RunOnAll([&](uint32_t s) { results[s] = shards_[s]->Checkpoint(lsn, dedup_); });
+  absl::Status status;
+  for (const absl::Status& r : results) {
+    if (!r.ok()) {
+      status = r;
+      break;
+    }
+  }
+  if (status.ok()) status = wal_->DropThrough(lsn);
+  // Reader slots of processes that died while reading (a backup tool, mdb_stat) would pin old
+  // pages forever; clearing them with every checkpoint bounds the file's growth.
+  for (const auto& shard : shards_) (void)shard->env().ClearStaleReaders();
+  if (!status.ok()) {
+    std::lock_guard lock(queue_mutex_);
+    if (write_error_.ok()) write_error_ = status;
+  }
+  return status;
+}
+
+std::vector<float> MapStore::Predict(std::span<const uint64_t> keys, std::span<const double> times,
+                                     const PredictOptions& options) const {
+  std::vector<float> out;
+  out.reserve(keys.size() * times.size());
+  for (double t : times) {
+    const model::PhasorTable table(settings_->periods, t);
+    for (uint64_t key : keys) out.push_back(ShardFor(key).Predict(key, table, options));
+  }
+  return out;
+}
+
+absl::Status MapStore::PredictBox(const CellBox& box, double t, const PredictOptions& options,
+                                  std::vector<float>& out) const {
+  if (info_.kind != MapKind::kGrid) {
+    return absl::FailedPreconditionError(absl::StrCat("map ", info_.name, " is not a grid: it has no boxes"));
+  }
+  static constexpr const char* kAxes[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    if (box.lo[a] >= box.hi[a] || box.hi[a] > info_.grid.size[a]) {
+      return absl::OutOfRangeError(absl::StrCat("box along ", kAxes[a], " must satisfy lo < hi ≤ ", info_.grid.size[a],
+                                                ", got [", box.lo[a], ", ", box.hi[a], ")"));
+    }
+  }
+  const model::PhasorTable table(settings_->periods, t);
+  out.assign(box.cell_count(), kUnobservedProbability);
+  ForEachShardInParallel(shards_.size(), box.cell_count() >= (1u << 16),
+                         [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); });
+  return absl::OkStatus();
+}
+
+std::optional<StateSnapshot> MapStore::Snapshot(uint64_t key) const { return ShardFor(key).Snapshot(key); }
+
+absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStore::TopN(const std::string& group, double t, size_t n,
+                                                                      const PredictOptions& options) const {
+  std::vector<uint64_t> members;
+  {
+    std::lock_guard lock(groups_mutex_);
+    auto it = groups_.find(group);
+    if (it == groups_.end()) {
+      return absl::NotFoundError(absl::StrCat("map ", info_.name, " has no group \"", group, "\""));
+    }
+    members = it->second;
+  }
+  const model::PhasorTable table(settings_->periods, t);
+  std::vector<std::pair<uint64_t, float>> ranked;
+  ranked.reserve(members.size());
+  for (uint64_t key : members) ranked.emplace_back(key, ShardFor(key).Predict(key, table, options));
+  const size_t keep = std::min(n, ranked.size());
+  std::partial_sort(ranked.begin(), ranked.begin() + keep, ranked.end(), [](const auto& a, const auto& b) {
+    return a.second != b.second ? a.second > b.second : a.first < b.first;
+  });
+  ranked.resize(keep);
+  return ranked;
+}
+
+MapStats MapStore::Stats() const {
+  MapStats stats;
+  stats.totals.order_histogram.assign(settings_->max_order + 1, 0);
+  for (const auto& shard : shards_) {
+    const ShardStats s = shard->Stats();
+    stats.totals.states += s.states;
+    stats.totals.dynamic_states += s.dynamic_states;
+    stats.totals.observations += s.observations;
+    stats.totals.disk_bytes += s.disk_bytes;
+    stats.totals.memory_bytes += s.memory_bytes;
+    stats.totals.prediction_error_sum += s.prediction_error_sum;
+    stats.totals.prediction_error_states += s.prediction_error_states;
+    for (size_t l = 0; l < s.order_histogram.size(); ++l) stats.totals.order_histogram[l] += s.order_histogram[l];
+  }
+  {
+    // The committer owns the log; its counters are read racily but only for reporting.
+    stats.log_bytes = wal_->bytes();
+    stats.last_lsn = wal_->durable_lsn();
+  }
+  if (stats.totals.disk_bytes > 0) {
+    stats.compression_ratio = static_cast<double>(stats.totals.observations) / 8.0 / stats.totals.disk_bytes;
+  }
+  if (stats.totals.prediction_error_states > 0) {
+    stats.mean_prediction_error = stats.totals.prediction_error_sum / stats.totals.prediction_error_states;
+  }
+  return stats;
+}
+
+absl::Status MapStore::Backup(const std::string& dir) {
+  if (absl::Status s = MakeDir(dir); !s.ok()) return s;
+  if (absl::Status s = Checkpoint(); !s.ok()) return s;
+  // No checkpoint can run while this is held, so every shard's copy is at the same log position.
+  std::lock_guard backup(backup_mutex_);
+  for (uint32_t i = 0; i < shards_.size(); ++i) {
+    if (absl::Status s = shards_[i]->env().CopyTo(ShardDir(dir, i)); !s.ok()) return s;
+  }
+  std::ofstream info(dir + "/map.info", std::ios::binary | std::ios::trunc);
+  info << EncodeMapInfo(info_);
+  info.close();
+  if (!info) return absl::InternalError(absl::StrCat("cannot write ", dir, "/map.info"));
+  return absl::OkStatus();
+}
+
+}  // namespace fremen::storage

@@ -1,0 +1,153 @@
+// One open map: its shards, its write-ahead log and the committer thread that turns submitted
+// batches into durable, applied, acknowledged ones (storage/README.md, "Write path").
+//
+// Write path: Submit() validates a batch and queues it (ResourceExhausted when the queue is full:
+// the caller slows down — backpressure, not unbounded buffering). The committer takes every queued
+// batch, appends the new ones to the log and syncs once (group commit), has each shard's thread fold
+// its part in, and then calls each batch's callback with its acknowledgement. A (writer, sequence)
+// already applied is acknowledged as a duplicate and not applied again. Checkpoints (by log size or
+// on request) write the changed states of every shard to LMDB and drop the covered log segments.
+// Open() recovers: every shard from its checkpoint, then the log after it.
+//
+// Reads run concurrently with writes and see every acknowledged batch.
+// Thread-safety: every public method may be called from any thread.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/status/statusor.h"
+#include "storage/batch.h"
+#include "storage/cell_key.h"
+#include "storage/dedup_table.h"
+#include "storage/map_info.h"
+#include "storage/shard.h"
+#include "storage/shard_workers.h"
+#include "storage/wal/wal.h"
+
+namespace fremen::storage {
+
+struct StoreOptions {
+  // Shards of a new map when its info asks for 0. Default: one per core.
+  uint32_t default_shards = 0;
+  // Initial LMDB map size of each shard; grown on demand. Default: 64 MiB.
+  size_t initial_map_size = 64ull << 20;
+  // A checkpoint starts once the log holds this much; larger = fewer, longer checkpoints and a
+  // longer recovery. Default: 256 MiB.
+  uint64_t checkpoint_log_bytes = 256ull << 20;
+  // Log segment size. Default: 64 MiB.
+  uint64_t log_segment_bytes = 64ull << 20;
+  // Observations queued but not yet applied beyond which Submit refuses (ResourceExhausted).
+  // Default: 16M (about 100 MB of queued scans).
+  uint64_t max_queued_observations = 16ull << 20;
+};
+
+struct MapStats {
+  ShardStats totals;  // summed over shards
+  uint64_t log_bytes = 0;
+  uint64_t last_lsn = 0;
+  // Eq. 16: the raw observations (one bit each) over the bytes that hold the models.
+  double compression_ratio = 0;
+  // Mean ε_p (decayed prequential error at the selected order) over dynamic states with evidence.
+  double mean_prediction_error = 0;
+};
+
+class MapStore {
+ public:
+  using AckCallback = std::function<void(absl::StatusOr<BatchAck>)>;
+
+  static absl::StatusOr<std::unique_ptr<MapStore>> Open(const MapInfo& info, const std::string& dir,
+                                                        const StoreOptions& options);
+  ~MapStore();
+
+  const MapInfo& info() const { return info_; }
+  const model::ModelSettings& settings() const { return *settings_; }
+
+  // --- writes ---
+  // Validates and queues; `done` runs (on the committer thread) once the batch is durable and
+  // applied, or failed. An error returned here means `done` will not run.
+  absl::Status Submit(ObservationBatch batch, AckCallback done);
+  // Submit and wait.
+  absl::StatusOr<BatchAck> Write(ObservationBatch batch);
+  // Checkpoints now and waits.
+  absl::Status Checkpoint();
+  // Republishes every dynamic state's P with its best order (the update job's core), logged so that
+  // recovery repeats it at the same point among the batches. Waits; returns states published.
+  absl::StatusOr<uint64_t> PublishModels();
+  // Stops accepting writes, finishes the queued ones and checkpoints. Idempotent.
+  absl::Status Close();
+
+  // --- reads ---
+  // p at every (time, key): out[i·keys + j] for times[i], keys[j].
+  std::vector<float> Predict(std::span<const uint64_t> keys, std::span<const double> times,
+                             const PredictOptions& options) const;
+  // p(t) of every cell of a box of a grid, x fastest; unobserved cells 0.5.
+  absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options, std::vector<float>& out) const;
+  std::optional<StateSnapshot> Snapshot(uint64_t key) const;
+  // The n states of `group` most likely to be 1 at t, most likely first.
+  absl::StatusOr<std::vector<std::pair<uint64_t, float>>> TopN(const std::string& group, double t, size_t n,
+                                                               const PredictOptions& options) const;
+  MapStats Stats() const;
+  // A consistent copy of every shard and the map's info into `dir` (created, must be empty).
+  absl::Status Backup(const std::string& dir);
+
+ private:
+  struct Pending {
+    ObservationBatch batch;
+    AckCallback done;
+    BatchAck ack;
+    std::vector<uint8_t> accept;
+  };
+  // Requests the committer serves between groups, in order.
+  struct Control {
+    enum class Kind { kCheckpoint, kPublish } kind;
+    std::function<void(absl::StatusOr<uint64_t>)> done;
+  };
+
+  MapStore(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings);
+  absl::Status Recover();
+  void CommitLoop();
+  void CommitGroup(std::vector<Pending>& group);
+  absl::Status DoCheckpoint();
+  absl::StatusOr<uint64_t> DoPublish();
+  absl::StatusOr<uint64_t> RunControl(Control::Kind kind);
+  // Splits the accepted observations of a batch by shard.
+  void SplitByShard(const Pending& pending, std::vector<std::vector<uint64_t>>& keys,
+                    std::vector<std::vector<float>>& values) const;
+  void IndexLabels(std::span<const StateLabel> labels);
+  const Shard& ShardFor(uint64_t key) const { return *shards_[ShardOf(key, info_.shards)]; }
+
+  const MapInfo info_;
+  const std::string dir_;
+  const StoreOptions options_;
+  std::unique_ptr<model::ModelSettings> settings_;
+  std::vector<std::unique_ptr<Shard>> shards_;
+  std::unique_ptr<ShardWorkers> workers_;
+  std::unique_ptr<WalWriter> wal_;
+  DedupTable dedup_;  // committer only
+
+  std::mutex queue_mutex_;
+  std::condition_variable queue_ready_;
+  std::deque<Pending> queue_;
+  uint64_t queued_observations_ = 0;
+  bool closing_ = false;
+  std::vector<Control> controls_;
+  absl::Status write_error_;  // latched: a failed log sync or checkpoint stops all writes
+
+  std::mutex backup_mutex_;  // held by checkpoints and backups: a backup sees one checkpoint
+
+  mutable std::mutex groups_mutex_;
+  absl::flat_hash_map<std::string, std::vector<uint64_t>> groups_;
+
+  std::thread committer_;
+};
+
+}  // namespace fremen::storage

@@ -1,0 +1,455 @@
+#include "storage/shard.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "absl/strings/str_cat.h"
+#include "storage/cell_key.h"
+#include "storage/model/publication.h"
+#include "storage/model/record_codec.h"
+#include "storage/model/scan_update.h"
+#include "storage/static_bricks.h"
+
+namespace fremen::storage {
+
+namespace {
+
+constexpr char kStaticDb[] = "static";
+constexpr char kDynamicDb[] = "dynamic";
+constexpr char kLosslessDb[] = "lossless";
+constexpr char kLabelsDb[] = "labels";
+constexpr char kMetaDb[] = "meta";
+constexpr char kLsnKey[] = "checkpoint_lsn";
+constexpr char kDedupKey[] = "dedup";
+
+std::span<const uint8_t> Bytes(std::string_view s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
+std::string_view View(std::span<const uint8_t> b) { return {reinterpret_cast<const char*>(b.data()), b.size()}; }
+
+// The 3 low bits of an axis spread to their Morton positions: the index of a cell in its brick.
+constexpr std::array<uint32_t, 8> kLocalSpread = {0, 1, 8, 9, 64, 65, 72, 73};
+inline uint32_t LocalIndex(uint32_t x, uint32_t y, uint32_t z) {
+  return kLocalSpread[x & 7] | kLocalSpread[y & 7] << 1 | kLocalSpread[z & 7] << 2;
+}
+
+absl::Status WithKey(const absl::Status& s, const char* family, uint64_t key) {
+  return absl::Status(s.code(), absl::StrCat(family, " record of state ", key, ": ", s.message()));
+}
+
+}  // namespace
+
+Shard::Shard(const MapInfo& map, const model::ModelSettings& settings, std::unique_ptr<LmdbEnv> env)
+    : map_(map),
+      settings_(settings),
+      lossless_(map.lossless_sampling_period > 0),
+      env_(std::move(env)),
+      spectra_(settings.periods.size()),
+      models_(settings.max_order),
+      errors_(settings.max_order) {}
+
+absl::StatusOr<std::unique_ptr<Shard>> Shard::Open(const MapInfo& map, const model::ModelSettings& settings,
+                                                   const std::string& dir, const LmdbOptions& options) {
+  auto env = LmdbEnv::Open(dir, options);
+  if (!env.ok()) return env.status();
+  auto shard = std::unique_ptr<Shard>(new Shard(map, settings, *std::move(env)));
+  if (absl::Status loaded = shard->Load(); !loaded.ok()) return loaded;
+  return shard;
+}
+
+uint32_t Shard::FindSlot(uint64_t key) const {
+  const auto it = bricks_.find(BrickOf(key));
+  return it == bricks_.end() ? kNone : brick_data_[it->second].slots[key & 511];
+}
+
+Shard::Brick& Shard::BrickFor(uint64_t key) {
+  const uint64_t brick = BrickOf(key);
+  if (brick != cached_brick_) {
+    auto [it, inserted] = bricks_.try_emplace(brick, static_cast<uint32_t>(brick_data_.size()));
+    if (inserted) {
+      brick_data_.emplace_back();
+      brick_data_.back().slots.fill(kNone);
+      brick_data_.back().handles.fill(kNone);
+    }
+    cached_brick_ = brick;
+    cached_brick_index_ = it->second;
+  }
+  return brick_data_[cached_brick_index_];
+}
+
+uint32_t Shard::FindOrAddSlot(uint64_t key) {
+  uint32_t& slot = BrickFor(key).slots[key & 511];
+  if (slot == kNone) {
+    slot = static_cast<uint32_t>(slots_.size());
+    slots_.push_back({});
+    slots_.back().key = key;
+  }
+  return slot;
+}
+
+void Shard::MarkDirty(uint32_t slot) {
+  if (!slots_[slot].dirty) {
+    slots_[slot].dirty = 1;
+    dirty_slots_.push_back(slot);
+  }
+}
+
+uint32_t Shard::AddDynamic(uint32_t slot) {
+  const uint32_t d = static_cast<uint32_t>(slot_of_.size());
+  slot_of_.push_back(slot);
+  spectra_.Append();
+  models_.Resize(d + 1);
+  errors_.Resize(d + 1);
+  persistence_.emplace_back();
+  if (lossless_) {
+    lossless_histories_.push_back(*model::LosslessHistory::Create(map_.lossless_origin, map_.lossless_sampling_period));
+  }
+  slots_[slot].dynamic = d;
+  SetHandle(slots_[slot].key, d);
+  return d;
+}
+
+uint32_t Shard::Promote(uint32_t slot) {
+  const uint32_t d = AddDynamic(slot);
+  if (slots_[slot].static_state.count() > 0) {
+    model::CompactStateModel promoted(settings_);
+    slots_[slot].static_state.Promote(settings_, promoted);
+    StoreModel(d, promoted);
+  }
+  return d;
+}
+
+void Shard::StoreModel(uint32_t d, const model::CompactStateModel& m) {
+  spectra_.Store(d, m.spectrum());
+  if (m.has_published()) {
+    models_.Set(d, m.published());
+  } else {
+    models_.SetUnpublished(d, static_cast<float>(m.spectrum().gamma0()));
+  }
+  persistence_[d] = m.persistence();
+  errors_.Set(d, m.order_errors());
+}
+
+model::CompactStateModel Shard::ModelOf(uint32_t d) const {
+  model::CompactStateModel m(settings_);
+  spectra_.Load(d, m.mutable_spectrum());
+  if (models_.published(d)) {
+    const model::CompactModelHeader& h = models_.header(d);
+    m.set_published(model::PublishedModel::Restore(h.alpha0, h.order, models_.Components(d)));
+  }
+  m.mutable_persistence() = persistence_[d];
+  m.mutable_order_errors() = errors_.Get(d);
+  return m;
+}
+
+void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::span<const float> values) {
+  std::unique_lock lock(mutex_);
+  const double t = scan.table.time();
+  scan_cells_.clear();
+  scan_values_.clear();
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const uint32_t slot = FindOrAddSlot(keys[i]);
+    MarkDirty(slot);
+    uint32_t d = slots_[slot].dynamic;
+    if (d == kNone) {
+      if (!lossless_ && slots_[slot].static_state.Accepts(values[i])) {
+        slots_[slot].static_state.Observe(t, values[i]);
+        SetHandle(keys[i], kStaticHandle | (values[i] == 1.0f ? 1u : 0u));
+        continue;
+      }
+      d = Promote(slot);
+    }
+    scan_cells_.push_back(d);
+    scan_values_.push_back(values[i]);
+  }
+  const model::ScanScoring scoring{&models_, &errors_, settings_.criterion, settings_.error_half_life};
+  model::ScoreAndApplyScan(spectra_, scoring, scan.table, scan.phasors, scan_cells_, scan_values_);
+  for (size_t j = 0; j < scan_cells_.size(); ++j) {
+    persistence_[scan_cells_[j]].Observe(t, scan_values_[j]);
+    // The batch was validated against the map's lossless origin, so Add cannot fail on time.
+    if (lossless_) (void)lossless_histories_[scan_cells_[j]].Add(t, scan_values_[j]);
+  }
+}
+
+void Shard::ApplyLabels(std::span<const StateLabel> labels) {
+  std::unique_lock lock(mutex_);
+  for (const StateLabel& label : labels) {
+    labels_[label.key] = {label.name, label.group};
+    dirty_labels_.push_back(label.key);
+  }
+}
+
+size_t Shard::PublishAll() {
+  std::unique_lock lock(mutex_);
+  model::PublishAll(spectra_, errors_, settings_.periods, models_);
+  for (uint32_t d = 0; d < slot_of_.size(); ++d) {
+    if (settings_.error_half_life == 0) errors_.Reset(d);  // "only since the last update"
+    MarkDirty(slot_of_[d]);
+  }
+  return slot_of_.size();
+}
+
+float Shard::PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f,
+                           const float* sin_f, const PredictOptions& options) const {
+  if (handle == kNone) return kUnobservedProbability;
+  if (handle & kStaticHandle) return static_cast<float>(handle & 1u);  // persistence agrees: s(t_l) = value
+  const uint32_t d = handle;
+  const model::CompactModelHeader& h = models_.header(d);
+  float p;
+  if (!h.published) {
+    const model::SpectrumHeader& sh = spectra_.header(d);
+    p = sh.n > 0 ? static_cast<float>(sh.sum_s / sh.n) : kUnobservedProbability;
+  } else {
+    const int order = std::min(options.order < 0 ? static_cast<int>(h.order) : options.order, settings_.max_order);
+    const uint16_t* k = models_.k(d);
+    const float* a = models_.a(d);
+    const float* b = models_.b(d);
+    p = h.alpha0;
+    for (int j = 0; j < order; ++j) p += a[j] * cos_f[k[j]] - b[j] * sin_f[k[j]];
+    p = std::clamp(p, 0.0f, 1.0f);
+  }
+  if (options.persistence && settings_.persistence) {
+    p = static_cast<float>(persistence_[d].Predict(table.time(), p));
+  }
+  return p;
+}
+
+float Shard::Predict(uint64_t key, const model::PhasorTable& table, const PredictOptions& options) const {
+  std::shared_lock lock(mutex_);
+  const auto it = bricks_.find(BrickOf(key));
+  if (it == bricks_.end()) return kUnobservedProbability;
+  return PredictHandle(brick_data_[it->second].handles[key & 511], table, table.cos_f(), table.sin_f(), options);
+}
+
+void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
+                       float* out) const {
+  if (box.cell_count() == 0) return;
+  std::shared_lock lock(mutex_);
+  const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
+  const float* cos_f = table.cos_f();
+  const float* sin_f = table.sin_f();
+  for (uint32_t bz = box.lo[2] >> 3; bz <= (box.hi[2] - 1) >> 3; ++bz) {
+    for (uint32_t by = box.lo[1] >> 3; by <= (box.hi[1] - 1) >> 3; ++by) {
+      for (uint32_t bx = box.lo[0] >> 3; bx <= (box.hi[0] - 1) >> 3; ++bx) {
+        const auto it = bricks_.find(BrickOf(MortonKey(bx << 3, by << 3, bz << 3)));
+        if (it == bricks_.end()) continue;
+        const Brick& brick = brick_data_[it->second];
+        const uint32_t z0 = std::max(box.lo[2], bz << 3), z1 = std::min(box.hi[2], (bz << 3) + 8);
+        const uint32_t y0 = std::max(box.lo[1], by << 3), y1 = std::min(box.hi[1], (by << 3) + 8);
+        const uint32_t x0 = std::max(box.lo[0], bx << 3), x1 = std::min(box.hi[0], (bx << 3) + 8);
+        for (uint32_t z = z0; z < z1; ++z) {
+          for (uint32_t y = y0; y < y1; ++y) {
+            float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
+            for (uint32_t x = x0; x < x1; ++x) {
+              const uint32_t handle = brick.handles[LocalIndex(x, y, z)];
+              if (handle != kNone) row[x] = PredictHandle(handle, table, cos_f, sin_f, options);
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+std::optional<StateSnapshot> Shard::Snapshot(uint64_t key) const {
+  std::shared_lock lock(mutex_);
+  const uint32_t slot = FindSlot(key);
+  if (slot == kNone) return std::nullopt;
+  StateSnapshot snapshot;
+  const uint32_t d = slots_[slot].dynamic;
+  snapshot.is_static = d == kNone;
+  snapshot.static_state = slots_[slot].static_state;
+  if (d != kNone) {
+    snapshot.model = ModelOf(d);
+    if (lossless_) snapshot.lossless = lossless_histories_[d];
+  }
+  if (auto it = labels_.find(key); it != labels_.end()) {
+    snapshot.name = it->second.first;
+    snapshot.group = it->second.second;
+  }
+  return snapshot;
+}
+
+ShardStats Shard::Stats() const {
+  std::shared_lock lock(mutex_);
+  ShardStats stats;
+  stats.states = slots_.size();
+  stats.dynamic_states = slot_of_.size();
+  stats.order_histogram.assign(settings_.max_order + 1, 0);
+  for (size_t slot = 0; slot < slots_.size(); ++slot) {
+    const uint32_t d = slots_[slot].dynamic;
+    stats.observations += d == kNone ? slots_[slot].static_state.count() : spectra_.header(d).n;
+  }
+  for (uint32_t d = 0; d < slot_of_.size(); ++d) {
+    const model::CompactModelHeader& h = models_.header(d);
+    if (h.published) stats.order_histogram[h.order]++;
+    const model::OrderErrors errors = errors_.Get(d);
+    if (errors.weight() > 0) {
+      stats.prediction_error_sum += errors.ErrorRate(h.order);
+      stats.prediction_error_states++;
+    }
+  }
+  stats.memory_bytes = spectra_.bytes() + models_.bytes() + errors_.bytes() +
+                       persistence_.capacity() * sizeof(model::Persistence) +
+                       slots_.capacity() * sizeof(Slot) +
+                       brick_data_.capacity() * sizeof(Brick);
+  if (auto used = env_->UsedBytes(); used.ok()) stats.disk_bytes = *used;
+  return stats;
+}
+
+void Shard::ForEachKey(const std::function<void(uint64_t)>& f) const {
+  std::shared_lock lock(mutex_);
+  for (const Slot& slot : slots_) f(slot.key);
+}
+
+void Shard::ForEachLabel(
+    const std::function<void(uint64_t, const std::string&, const std::string&)>& f) const {
+  std::shared_lock lock(mutex_);
+  for (const auto& [key, label] : labels_) f(key, label.first, label.second);
+}
+
+absl::Status Shard::Checkpoint(uint64_t lsn, const DedupTable& dedup) {
+  std::shared_lock lock(mutex_);  // the writer is the caller: only readers run alongside
+  std::vector<uint32_t> dirty = dirty_slots_;
+  std::sort(dirty.begin(), dirty.end(), [&](uint32_t a, uint32_t b) { return slots_[a].key < slots_[b].key; });
+  std::vector<uint64_t> dirty_bricks;
+  for (uint32_t slot : dirty) {
+    const uint64_t brick = BrickOf(slots_[slot].key);
+    if (dirty_bricks.empty() || dirty_bricks.back() != brick) dirty_bricks.push_back(brick);
+  }
+  const absl::Status written = env_->Write([&](LmdbTxn& txn) -> absl::Status {
+    auto static_db = txn.OpenDb(kStaticDb, true);
+    auto dynamic_db = txn.OpenDb(kDynamicDb, true);
+    auto lossless_db = txn.OpenDb(kLosslessDb, true);
+    auto labels_db = txn.OpenDb(kLabelsDb, true);
+    auto meta_db = txn.OpenDb(kMetaDb, true);
+    for (auto* db : {&static_db, &dynamic_db, &lossless_db, &labels_db, &meta_db}) {
+      if (!db->ok()) return db->status();
+    }
+    for (uint32_t slot : dirty) {
+      const uint32_t d = slots_[slot].dynamic;
+      if (d == kNone) continue;
+      const auto key = KeyBytes(slots_[slot].key);
+      const std::string record = model::EncodeStateModel(ModelOf(d));
+      if (absl::Status s = txn.Put(*dynamic_db, key, Bytes(record)); !s.ok()) return s;
+      if (lossless_) {
+        const std::string history = lossless_histories_[d].Encode();
+        if (absl::Status s = txn.Put(*lossless_db, key, Bytes(history)); !s.ok()) return s;
+      }
+    }
+    // A brick's never-changed states are written together; a brick left with none is deleted.
+    for (uint64_t brick : dirty_bricks) {
+      const Brick& data = brick_data_[bricks_.at(brick)];
+      StaticBrick value;
+      for (uint32_t i = 0; i < 512; ++i) {
+        const uint32_t slot = data.slots[i];
+        if (slot != kNone && slots_[slot].dynamic == kNone) value.Add(i, slots_[slot].static_state);
+      }
+      const auto key = KeyBytes(brick);
+      absl::Status s = value.empty() ? txn.Delete(*static_db, key) : txn.Put(*static_db, key, Bytes(value.Encode()));
+      if (!s.ok()) return s;
+    }
+    for (uint64_t key : dirty_labels_) {
+      const auto& [name, group] = labels_.at(key);
+      std::string value;
+      model::PutVarint64(&value, name.size());
+      value += name;
+      model::PutVarint64(&value, group.size());
+      value += group;
+      if (absl::Status s = txn.Put(*labels_db, KeyBytes(key), Bytes(value)); !s.ok()) return s;
+    }
+    uint8_t lsn_bytes[8];
+    std::memcpy(lsn_bytes, &lsn, 8);
+    if (absl::Status s = txn.Put(*meta_db, Bytes(kLsnKey), lsn_bytes); !s.ok()) return s;
+    return txn.Put(*meta_db, Bytes(kDedupKey), Bytes(dedup.Encode()));
+  });
+  if (!written.ok()) return written;
+  lock.unlock();
+  std::unique_lock exclusive(mutex_);
+  for (uint32_t slot : dirty_slots_) slots_[slot].dirty = 0;
+  dirty_slots_.clear();
+  dirty_labels_.clear();
+  checkpoint_lsn_ = lsn;
+  checkpoint_dedup_ = dedup;
+  return absl::OkStatus();
+}
+
+absl::Status Shard::Load() {
+  return env_->Read([&](LmdbTxn& txn) -> absl::Status {
+    auto meta_db = txn.OpenDb(kMetaDb, false);
+    if (absl::IsNotFound(meta_db.status())) return absl::OkStatus();  // a new shard
+    if (!meta_db.ok()) return meta_db.status();
+    if (auto lsn = txn.Get(*meta_db, Bytes(kLsnKey)); lsn.ok()) {
+      if (lsn->size() != 8) return absl::DataLossError("shard meta: checkpoint_lsn is not 8 bytes");
+      std::memcpy(&checkpoint_lsn_, lsn->data(), 8);
+    }
+    if (auto dedup = txn.Get(*meta_db, Bytes(kDedupKey)); dedup.ok()) {
+      auto table = DedupTable::Decode(View(*dedup));
+      if (!table.ok()) return table.status();
+      checkpoint_dedup_ = *std::move(table);
+    }
+    absl::Status failure;
+    const auto scan = [&](const char* family, const std::function<absl::Status(uint64_t, std::string_view)>& f) {
+      auto db = txn.OpenDb(family, false);
+      if (absl::IsNotFound(db.status())) return absl::OkStatus();
+      if (!db.ok()) return db.status();
+      absl::Status scanned = txn.Scan(*db, {}, {}, [&](auto key, auto value) {
+        if (key.size() != 8) {
+          failure = absl::DataLossError(absl::StrCat(family, ": a key is ", key.size(), " bytes, not 8"));
+          return false;
+        }
+        const uint64_t k = KeyFromBytes(key.data());
+        if (absl::Status s = f(k, View(value)); !s.ok()) {
+          failure = WithKey(s, family, k);
+          return false;
+        }
+        return true;
+      });
+      return scanned.ok() ? failure : scanned;
+    };
+    if (absl::Status s = scan(kStaticDb, [&](uint64_t brick, std::string_view value) -> absl::Status {
+          auto decoded = StaticBrick::Decode(value);
+          if (!decoded.ok()) return decoded.status();
+          decoded->ForEach([&](uint32_t i, const model::StaticState& state) {
+            const uint64_t key = brick << kBrickBits | i;
+            slots_[FindOrAddSlot(key)].static_state = state;
+            SetHandle(key, kStaticHandle | static_cast<uint32_t>(state.value()));
+          });
+          return absl::OkStatus();
+        });
+        !s.ok()) {
+      return s;
+    }
+    if (absl::Status s = scan(kDynamicDb, [&](uint64_t key, std::string_view value) -> absl::Status {
+          auto decoded = model::DecodeStateModel<float>(value, settings_);
+          if (!decoded.ok()) return decoded.status();
+          const uint32_t slot = FindOrAddSlot(key);
+          StoreModel(slots_[slot].dynamic == kNone ? AddDynamic(slot) : slots_[slot].dynamic, *decoded);
+          return absl::OkStatus();
+        });
+        !s.ok()) {
+      return s;
+    }
+    if (absl::Status s = scan(kLosslessDb, [&](uint64_t key, std::string_view value) -> absl::Status {
+          auto decoded = model::LosslessHistory::Decode(value);
+          if (!decoded.ok()) return decoded.status();
+          const uint32_t slot = FindSlot(key);
+          if (!lossless_ || slot == kNone || slots_[slot].dynamic == kNone) {
+            return absl::DataLossError("a lossless history without its state");
+          }
+          lossless_histories_[slots_[slot].dynamic] = *std::move(decoded);
+          return absl::OkStatus();
+        });
+        !s.ok()) {
+      return s;
+    }
+    return scan(kLabelsDb, [&](uint64_t key, std::string_view value) -> absl::Status {
+      model::ByteReader r(value, "labels");
+      std::string name(r.Bytes(r.Varint("name length"), "name"));
+      std::string group(r.Bytes(r.Varint("group length"), "group"));
+      if (absl::Status s = r.Finish(); !s.ok()) return s;
+      labels_[key] = {std::move(name), std::move(group)};
+      return absl::OkStatus();
+    });
+  });
+}
+
+}  // namespace fremen::storage

@@ -1,0 +1,192 @@
+// One shard of a map: the working models of the states whose bricks hash to it (storage/cell_key.h),
+// held in memory in the batch kernels' flat tables, and the LMDB environment they are checkpointed
+// into.
+//
+// A state is first a 16-byte StaticState (never changed); its first change promotes it to a dynamic
+// state with a row in each table: float spectrum (RecordArena), published model (CompactModels),
+// persistence, order errors (and, on lossless maps, its LosslessHistory). States are found through
+// bricks: 512 consecutive keys (an 8×8×8 block of a grid) share one hash lookup, which is what makes
+// a box query a walk over arrays rather than a lookup per cell.
+//
+// On disk (one LMDB environment per shard):
+//   static    brick key → version, 64-byte presence bitmap, 16 bytes per present never-changed state
+//   dynamic   state key → EncodeStateModel<float> (spectrum, P, persistence, order errors)
+//   lossless  state key → LosslessHistory record (lossless maps)
+//   labels    state key → name and group (generic maps)
+//   meta      "checkpoint_lsn" → the last log record the checkpoint covers; "dedup" → DedupTable
+// Keys are big-endian so that LMDB's order is key order (Morton order for grids).
+//
+// Thread-safety: Apply*, Checkpoint and Publish are called by one writer (the map's committer,
+// through the shard's owner); readers may call the const query methods concurrently with them —
+// an internal shared mutex keeps a reader from seeing a half-applied batch.
+#pragma once
+
+#include <array>
+#include <functional>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <shared_mutex>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/status/statusor.h"
+#include "storage/batch.h"
+#include "storage/dedup_table.h"
+#include "storage/lmdb/lmdb_env.h"
+#include "storage/map_info.h"
+#include "storage/model/compact_models.h"
+#include "storage/model/lossless_history.h"
+#include "storage/model/order_error_table.h"
+#include "storage/model/persistence.h"
+#include "storage/model/record_arena.h"
+#include "storage/model/state_model.h"
+#include "storage/model/static_state.h"
+
+namespace fremen::storage {
+
+// Everything about one scan time that every shard shares: computed once per batch.
+struct ScanContext {
+  explicit ScanContext(const model::PeriodSet& periods, double t) : table(periods, t), phasors(table) {}
+  model::PhasorTable table;
+  model::ScanPhasors<float> phasors;
+};
+
+struct PredictOptions {
+  bool persistence = false;  // blend in the last observation (§III-D)
+  int order = -1;            // -1: each state's selected order
+};
+
+// A box of grid cells, [lo, hi) per axis.
+struct CellBox {
+  std::array<uint32_t, 3> lo = {0, 0, 0};
+  std::array<uint32_t, 3> hi = {0, 0, 0};
+  uint64_t cell_count() const { return uint64_t{hi[0] - lo[0]} * (hi[1] - lo[1]) * (hi[2] - lo[2]); }
+};
+
+// A copy of one state's complete model, for the full-model view and for tests.
+struct StateSnapshot {
+  bool is_static = true;
+  model::StaticState static_state;               // when is_static
+  std::optional<model::CompactStateModel> model;  // when dynamic
+  std::optional<model::LosslessHistory> lossless;
+  std::string name, group;
+};
+
+struct ShardStats {
+  uint64_t states = 0;
+  uint64_t dynamic_states = 0;
+  uint64_t observations = 0;  // Σ n over states
+  uint64_t disk_bytes = 0;
+  uint64_t memory_bytes = 0;
+  std::vector<uint64_t> order_histogram;  // selected order of dynamic published states, 0..L
+  double prediction_error_sum = 0;        // Σ ε_p(selected order) over dynamic states with evidence
+  uint64_t prediction_error_states = 0;
+};
+
+// The value an unobserved state predicts: no information either way.
+inline constexpr float kUnobservedProbability = 0.5f;
+
+class Shard {
+ public:
+  // Opens (creating when missing) the shard's environment and loads every state into memory.
+  static absl::StatusOr<std::unique_ptr<Shard>> Open(const MapInfo& map, const model::ModelSettings& settings,
+                                                     const std::string& dir, const LmdbOptions& options);
+
+  // --- writer side ---
+  // Folds accepted observations (keys of this shard, values in [0, 1]) taken at the scan's time.
+  void Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::span<const float> values);
+  void ApplyLabels(std::span<const StateLabel> labels);
+  // The update of §IV-B for every dynamic state: choose the order with the lowest decayed error and
+  // republish P from the spectrum (SPEC §2.4). Returns how many states were published.
+  size_t PublishAll();
+  // Writes every state changed since the last checkpoint, the dedup table and `lsn` in one durable
+  // transaction.
+  absl::Status Checkpoint(uint64_t lsn, const DedupTable& dedup);
+  uint64_t checkpoint_lsn() const { return checkpoint_lsn_; }
+  const DedupTable& checkpoint_dedup() const { return checkpoint_dedup_; }
+
+  // --- readers ---
+  // p(t) of one state (kUnobservedProbability when never observed).
+  float Predict(uint64_t key, const model::PhasorTable& table, const PredictOptions& options) const;
+  // Writes p(t) of every cell of `box` held by this shard into out[index of the cell in the box]
+  // (x fastest, then y, then z); cells it does not hold are left as they are.
+  void PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
+                  float* out) const;
+  std::optional<StateSnapshot> Snapshot(uint64_t key) const;
+  ShardStats Stats() const;
+  // Calls f(key) for every state held (unordered).
+  void ForEachKey(const std::function<void(uint64_t)>& f) const;
+  // Calls f(key, name, group) for every labelled state (unordered).
+  void ForEachLabel(const std::function<void(uint64_t, const std::string&, const std::string&)>& f) const;
+
+  LmdbEnv& env() { return *env_; }
+
+ private:
+  Shard(const MapInfo& map, const model::ModelSettings& settings, std::unique_ptr<LmdbEnv> env);
+
+  static constexpr uint32_t kNone = UINT32_MAX;
+  // A handle says what predicting a cell needs without touching its slot: kNone (unobserved),
+  // kStaticHandle | value (never changed), or the dynamic index.
+  static constexpr uint32_t kStaticHandle = 0x80000000u;
+  struct Brick {
+    std::array<uint32_t, 512> slots;    // slot of key (brick << 9 | i), or kNone
+    std::array<uint32_t, 512> handles;  // see kStaticHandle
+  };
+
+  uint32_t FindSlot(uint64_t key) const;
+  // The brick of a key, created when missing. Consecutive calls for one brick cost no hash lookup.
+  Brick& BrickFor(uint64_t key);
+  uint32_t FindOrAddSlot(uint64_t key);
+  void SetHandle(uint64_t key, uint32_t handle) { BrickFor(key).handles[key & 511] = handle; }
+  uint32_t Promote(uint32_t slot);  // static → dynamic; returns the dynamic index
+  uint32_t AddDynamic(uint32_t slot);
+  void MarkDirty(uint32_t slot);
+  float PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f, const float* sin_f,
+                      const PredictOptions& options) const;
+  model::CompactStateModel ModelOf(uint32_t dynamic) const;
+  void StoreModel(uint32_t dynamic, const model::CompactStateModel& model);
+  absl::Status Load();
+
+  const MapInfo map_;
+  const model::ModelSettings& settings_;
+  const bool lossless_;
+  std::unique_ptr<LmdbEnv> env_;
+  mutable std::shared_mutex mutex_;
+
+  absl::flat_hash_map<uint64_t, uint32_t> bricks_;  // brick → index into bricks_data_
+  std::vector<Brick> brick_data_;
+  uint64_t cached_brick_ = UINT64_MAX;  // BrickFor's last brick and its index
+  uint32_t cached_brick_index_ = 0;
+  // Per slot.
+  // Per slot, everything the write path touches in one 32-byte record (one cache line access).
+  struct Slot {
+    model::StaticState static_state;
+    uint64_t key = 0;
+    uint32_t dynamic = kNone;  // kNone while static
+    uint32_t dirty = 0;
+  };
+  static_assert(sizeof(Slot) == 32);
+  std::vector<Slot> slots_;
+  std::vector<uint32_t> dirty_slots_;
+  // Per dynamic state.
+  std::vector<uint32_t> slot_of_;
+  model::RecordArena spectra_;
+  model::CompactModels models_;
+  model::OrderErrorTable errors_;
+  std::vector<model::Persistence> persistence_;
+  std::vector<model::LosslessHistory> lossless_histories_;
+  // Generic maps' labels.
+  absl::flat_hash_map<uint64_t, std::pair<std::string, std::string>> labels_;
+  std::vector<uint64_t> dirty_labels_;
+  // Scratch of Apply.
+  std::vector<uint32_t> scan_cells_;
+  std::vector<float> scan_values_;
+
+  uint64_t checkpoint_lsn_ = 0;
+  DedupTable checkpoint_dedup_;
+};
+
+}  // namespace fremen::storage
