@@ -67,12 +67,13 @@ BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector
     ++ack.rejected;
     if (ack.rejections.size() < kMaxReportedRejections) ack.rejections.push_back({static_cast<uint32_t>(i), reason});
   };
+  const GridKeys keys = map.grid.keys();
   for (size_t i = 0; i < batch.keys.size(); ++i) {
     if (!ValueOk(batch.values[i])) {
       reject(i, RejectReason::kValueOutOfRange);
     } else if (map.kind == MapKind::kGrid) {
-      const auto cell = MortonCell(batch.keys[i]);
-      if (MortonKey(cell[0], cell[1], cell[2]) != batch.keys[i] || !map.grid.Contains(cell[0], cell[1], cell[2])) {
+      const auto cell = keys.Cell(batch.keys[i]);
+      if (!keys.IsCellKey(batch.keys[i]) || !map.grid.Contains(cell[0], cell[1], cell[2])) {
         reject(i, RejectReason::kOutsideMap);
       }
     }

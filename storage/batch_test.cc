@@ -22,7 +22,7 @@ ObservationBatch Scan() {
   batch.sequence = 99;
   batch.time = 1.7e9 + 0.25;
   for (uint32_t x = 0; x < 5; ++x) {
-    batch.keys.push_back(MortonKey(x, 2, 0));
+    batch.keys.push_back(Grid().grid.keys().Key(x, 2, 0));
     batch.values.push_back(x % 2 ? 1.0f : 0.0f);
   }
   batch.patch.origin = {1, 1, 0};
@@ -65,7 +65,7 @@ TEST(BatchTest, BadObservationsAreRejectedOneByOneWithReasons) {
   const MapInfo map = Grid();
   ObservationBatch batch = Scan();
   batch.values[1] = 1.5f;
-  batch.keys[3] = MortonKey(12, 0, 0);  // x outside the 10-cell grid
+  batch.keys[3] = uint64_t{12} | uint64_t{1} << 50;  // not a cell of this 2-D grid  // x outside the 10-cell grid
   batch.patch.values[4] = NAN;
   std::vector<uint8_t> accept;
   const BatchAck ack = Classify(map, batch, accept);

@@ -48,3 +48,36 @@ TEST(CellKeyTest, KeyBytesSortLikeKeys) {
 
 }  // namespace
 }  // namespace fremen::storage
+
+namespace fremen::storage {
+namespace {
+
+TEST(GridKeysTest, FlatGridsUseDenseTwoDimensionalKeys) {
+  const GridKeys flat = GridKeys::For(1), deep = GridKeys::For(4);
+  EXPECT_TRUE(flat.flat());
+  EXPECT_FALSE(deep.flat());
+  std::mt19937 rng(2);
+  std::uniform_int_distribution<uint32_t> any(0, kMaxGridIndex);
+  for (int i = 0; i < 10000; ++i) {
+    const uint32_t x = any(rng), y = any(rng), z = any(rng);
+    ASSERT_EQ(flat.Cell(flat.Key(x, y, 0)), (std::array<uint32_t, 3>{x, y, 0}));
+    ASSERT_EQ(deep.Cell(deep.Key(x, y, z)), (std::array<uint32_t, 3>{x, y, z}));
+    ASSERT_TRUE(flat.IsCellKey(flat.Key(x, y, 0)));
+  }
+  // A 32×16 block of a 2-D grid is one brick of 512 consecutive keys.
+  std::set<uint64_t> bricks, keys;
+  for (uint32_t x = 64; x < 96; ++x) {
+    for (uint32_t y = 16; y < 32; ++y) {
+      bricks.insert(BrickOf(flat.Key(x, y, 0)));
+      keys.insert(flat.Key(x, y, 0));
+      EXPECT_EQ(flat.LocalIndex(x, y, 0), flat.Key(x, y, 0) & 511);
+    }
+  }
+  EXPECT_EQ(bricks.size(), 1u);
+  EXPECT_EQ(*keys.rbegin() - *keys.begin(), 511u);
+  EXPECT_EQ(deep.LocalIndex(9, 10, 11), deep.Key(9, 10, 11) & 511);
+  EXPECT_FALSE(flat.IsCellKey(uint64_t{1} << 50));
+}
+
+}  // namespace
+}  // namespace fremen::storage

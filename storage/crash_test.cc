@@ -79,7 +79,7 @@ TEST(CrashTest, EveryAcknowledgedBatchSurvivesKillNineAndModelsMatchARecomputati
     for (uint32_t x = 0; x < 48; x += 3) {
       for (uint32_t y = 0; y < 48; ++y) {
         for (uint32_t z = 0; z < 4; ++z) {
-          const uint64_t key = MortonKey(x, y, z);
+          const uint64_t key = map.grid.keys().Key(x, y, z);
           const auto got = (*store)->Snapshot(key), want = (*reference)->Snapshot(key);
           ASSERT_EQ(got.has_value(), want.has_value());
           if (!got) continue;

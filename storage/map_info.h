@@ -14,6 +14,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "storage/cell_key.h"
 #include "storage/model/model_settings.h"
 
 namespace fremen::storage {
@@ -33,6 +34,8 @@ struct GridGeometry {
 
   uint64_t cell_count() const { return uint64_t{size[0]} * size[1] * size[2]; }
   bool Contains(uint32_t x, uint32_t y, uint32_t z) const { return x < size[0] && y < size[1] && z < size[2]; }
+  // How this grid's cells are keyed (2-D Morton when one cell thick).
+  GridKeys keys() const { return GridKeys::For(size[2]); }
   // The cell holding a metric point; nullopt outside the grid (or for a non-finite point).
   std::optional<std::array<uint32_t, 3>> CellOf(double x, double y, double z) const;
   bool operator==(const GridGeometry&) const = default;

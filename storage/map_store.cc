@@ -80,8 +80,6 @@ absl::Status MapStore::Recover() {
     from = std::min(from, shard->checkpoint_lsn());
     dedup_.MergeFrom(shard->checkpoint_dedup());
   }
-  std::vector<std::vector<uint64_t>> keys;
-  std::vector<std::vector<float>> values;
   auto replayed = ReplayWal(dir_ + "/wal", from, [&](uint64_t lsn, std::span<const uint8_t> payload) -> absl::Status {
     if (payload.size() == 1 && payload[0] == kPublishRecord) {
       for (const auto& shard : shards_) {
@@ -95,13 +93,13 @@ absl::Status MapStore::Recover() {
     auto batch = DecodeBatch({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1});
     if (!batch.ok()) return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", batch.status().message()));
     dedup_.Record(batch->writer_id, batch->sequence);
-    Pending pending{*std::move(batch), nullptr, {}, {}};
+    Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}};
     pending.ack = Classify(info_, pending.batch, pending.accept);
-    SplitByShard(pending, keys, values);
+    SplitByShard(pending);
     const ScanContext scan(settings_->periods, pending.batch.time);
     for (uint32_t s = 0; s < shards_.size(); ++s) {
       if (shards_[s]->checkpoint_lsn() >= lsn) continue;  // the checkpoint has it already
-      shards_[s]->Apply(scan, keys[s], values[s]);
+      shards_[s]->Apply(scan, pending.keys[s], pending.values[s]);
       std::vector<StateLabel> mine;
       for (const StateLabel& l : pending.batch.labels) {
         if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);
@@ -124,8 +122,18 @@ absl::Status MapStore::Recover() {
   return absl::OkStatus();
 }
 
-void MapStore::SplitByShard(const Pending& pending, std::vector<std::vector<uint64_t>>& keys,
-                            std::vector<std::vector<float>>& values) const {
+MapStore::Pending MapStore::Prepare(ObservationBatch batch, AckCallback done) const {
+  Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}};
+  pending.ack = Classify(info_, pending.batch, pending.accept);
+  pending.record.push_back(kBatchRecord);
+  pending.record += EncodeBatch(pending.batch);
+  SplitByShard(pending);
+  return pending;
+}
+
+void MapStore::SplitByShard(Pending& pending) const {
+  std::vector<std::vector<uint64_t>>& keys = pending.keys;
+  std::vector<std::vector<float>>& values = pending.values;
   keys.resize(info_.shards);
   values.resize(info_.shards);
   for (uint32_t s = 0; s < info_.shards; ++s) {
@@ -140,12 +148,13 @@ void MapStore::SplitByShard(const Pending& pending, std::vector<std::vector<uint
     values[s].push_back(b.values[i]);
   }
   const DensePatch& p = b.patch;
+  const GridKeys grid_keys = info_.grid.keys();
   size_t j = b.keys.size();
   for (uint32_t z = 0; z < p.size[2]; ++z) {
     for (uint32_t y = 0; y < p.size[1]; ++y) {
       for (uint32_t x = 0; x < p.size[0]; ++x, ++j) {
         if (!pending.accept[j]) continue;
-        const uint64_t key = MortonKey(p.origin[0] + x, p.origin[1] + y, p.origin[2] + z);
+        const uint64_t key = grid_keys.Key(p.origin[0] + x, p.origin[1] + y, p.origin[2] + z);
         const uint32_t s = ShardOf(key, info_.shards);
         keys[s].push_back(key);
         values[s].push_back(p.values[j - b.keys.size()]);
@@ -160,8 +169,7 @@ absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
     return absl::InvalidArgumentError(absl::StrCat("time must not be before the map's lossless origin ",
                                                    info_.lossless_origin, ", got ", batch.time));
   }
-  Pending pending{std::move(batch), std::move(done), {}, {}};
-  pending.ack = Classify(info_, pending.batch, pending.accept);
+  Pending pending = Prepare(std::move(batch), std::move(done));
   const uint64_t n = pending.batch.observation_count();
   {
     std::lock_guard lock(queue_mutex_);
@@ -264,9 +272,7 @@ void MapStore::CommitGroup(std::vector<Pending>& group) {
         continue;
       }
       dedup_.Record(p.batch.writer_id, p.batch.sequence);
-      std::string record(1, kBatchRecord);
-      record += EncodeBatch(p.batch);
-      p.ack.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(record.data()), record.size()});
+      p.ack.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(p.record.data()), p.record.size()});
     }
     status = wal_->Sync();
   }
@@ -285,15 +291,10 @@ void MapStore::CommitGroup(std::vector<Pending>& group) {
   }
   std::vector<ScanContext> scans;
   scans.reserve(fresh.size());
-  std::vector<std::vector<std::vector<uint64_t>>> keys(fresh.size());
-  std::vector<std::vector<std::vector<float>>> values(fresh.size());
-  for (size_t b = 0; b < fresh.size(); ++b) {
-    scans.emplace_back(settings_->periods, fresh[b]->batch.time);
-    SplitByShard(*fresh[b], keys[b], values[b]);
-  }
+  for (const Pending* p : fresh) scans.emplace_back(settings_->periods, p->batch.time);
   workers_->RunOnAll([&](uint32_t s) {
     for (size_t b = 0; b < fresh.size(); ++b) {
-      shards_[s]->Apply(scans[b], keys[b][s], values[b][s]);
+      shards_[s]->Apply(scans[b], fresh[b]->keys[s], fresh[b]->values[s]);
       std::vector<StateLabel> mine;
       for (const StateLabel& l : fresh[b]->batch.labels) {
         if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);

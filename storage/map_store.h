@@ -100,11 +100,16 @@ class MapStore {
   absl::Status Backup(const std::string& dir);
 
  private:
+  // A submitted batch. Everything that needs no shared state — classification, the log record,
+  // the split by shard — is prepared by the submitting thread, off the committer's critical path.
   struct Pending {
     ObservationBatch batch;
     AckCallback done;
     BatchAck ack;
     std::vector<uint8_t> accept;
+    std::string record;                        // the log record
+    std::vector<std::vector<uint64_t>> keys;   // accepted observations by shard
+    std::vector<std::vector<float>> values;
   };
   // Requests the committer serves between groups, in order.
   struct Control {
@@ -120,8 +125,9 @@ class MapStore {
   absl::StatusOr<uint64_t> DoPublish();
   absl::StatusOr<uint64_t> RunControl(Control::Kind kind);
   // Splits the accepted observations of a batch by shard.
-  void SplitByShard(const Pending& pending, std::vector<std::vector<uint64_t>>& keys,
-                    std::vector<std::vector<float>>& values) const;
+  void SplitByShard(Pending& pending) const;
+  // Classifies, encodes and splits a batch.
+  Pending Prepare(ObservationBatch batch, AckCallback done) const;
   void IndexLabels(std::span<const StateLabel> labels);
   const Shard& ShardFor(uint64_t key) const { return *shards_[ShardOf(key, info_.shards)]; }
 

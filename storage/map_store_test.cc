@@ -28,7 +28,7 @@ void ExpectSameModels(const MapStore& a, const MapStore& b, const MapInfo& map) 
   for (uint32_t x = 0; x < map.grid.size[0]; ++x) {
     for (uint32_t y = 0; y < map.grid.size[1]; ++y) {
       for (uint32_t z = 0; z < map.grid.size[2]; ++z) {
-        const uint64_t key = MortonKey(x, y, z);
+        const uint64_t key = map.grid.keys().Key(x, y, z);
         const auto sa = a.Snapshot(key), sb = b.Snapshot(key);
         ASSERT_EQ(sa.has_value(), sb.has_value()) << x << "," << y << "," << z;
         if (!sa) continue;
@@ -127,7 +127,7 @@ TEST(MapStoreTest, PredictionsMatchTheModelsAndRegionsMatchPoints) {
   for (uint32_t z = box.lo[2]; z < box.hi[2]; ++z) {
     for (uint32_t y = box.lo[1]; y < box.hi[1]; ++y) {
       for (uint32_t x = box.lo[0]; x < box.hi[0]; ++x, ++i) {
-        const uint64_t key = MortonKey(x, y, z);
+        const uint64_t key = map.grid.keys().Key(x, y, z);
         const double times[] = {t};
         const float point = store->Predict({&key, 1}, times, {})[0];
         ASSERT_EQ(region[i], point) << x << "," << y << "," << z;

@@ -25,12 +25,6 @@ constexpr char kDedupKey[] = "dedup";
 std::span<const uint8_t> Bytes(std::string_view s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
 std::string_view View(std::span<const uint8_t> b) { return {reinterpret_cast<const char*>(b.data()), b.size()}; }
 
-// The 3 low bits of an axis spread to their Morton positions: the index of a cell in its brick.
-constexpr std::array<uint32_t, 8> kLocalSpread = {0, 1, 8, 9, 64, 65, 72, 73};
-inline uint32_t LocalIndex(uint32_t x, uint32_t y, uint32_t z) {
-  return kLocalSpread[x & 7] | kLocalSpread[y & 7] << 1 | kLocalSpread[z & 7] << 2;
-}
-
 absl::Status WithKey(const absl::Status& s, const char* family, uint64_t key) {
   return absl::Status(s.code(), absl::StrCat(family, " record of state ", key, ": ", s.message()));
 }
@@ -41,6 +35,7 @@ Shard::Shard(const MapInfo& map, const model::ModelSettings& settings, std::uniq
     : map_(map),
       settings_(settings),
       lossless_(map.lossless_sampling_period > 0),
+      grid_keys_(map.grid.keys()),
       env_(std::move(env)),
       spectra_(settings.periods.size()),
       models_(settings.max_order),
@@ -55,9 +50,16 @@ absl::StatusOr<std::unique_ptr<Shard>> Shard::Open(const MapInfo& map, const mod
   return shard;
 }
 
+uint32_t Shard::SlotAt(const Brick& brick, uint32_t local) const {
+  const uint32_t base = brick.chunk_base[local / kChunk];
+  if (base == kNone) return kNone;
+  const uint32_t slot = base + local % kChunk;
+  return slots_[slot].observed ? slot : kNone;
+}
+
 uint32_t Shard::FindSlot(uint64_t key) const {
   const auto it = bricks_.find(BrickOf(key));
-  return it == bricks_.end() ? kNone : brick_data_[it->second].slots[key & 511];
+  return it == bricks_.end() ? kNone : SlotAt(brick_data_[it->second], key & 511);
 }
 
 Shard::Brick& Shard::BrickFor(uint64_t key) {
@@ -66,8 +68,8 @@ Shard::Brick& Shard::BrickFor(uint64_t key) {
     auto [it, inserted] = bricks_.try_emplace(brick, static_cast<uint32_t>(brick_data_.size()));
     if (inserted) {
       brick_data_.emplace_back();
-      brick_data_.back().slots.fill(kNone);
       brick_data_.back().handles.fill(kNone);
+      brick_data_.back().chunk_base.fill(kNone);
     }
     cached_brick_ = brick;
     cached_brick_index_ = it->second;
@@ -76,12 +78,15 @@ Shard::Brick& Shard::BrickFor(uint64_t key) {
 }
 
 uint32_t Shard::FindOrAddSlot(uint64_t key) {
-  uint32_t& slot = BrickFor(key).slots[key & 511];
-  if (slot == kNone) {
-    slot = static_cast<uint32_t>(slots_.size());
-    slots_.push_back({});
-    slots_.back().key = key;
+  const uint32_t local = key & 511;
+  uint32_t& base = BrickFor(key).chunk_base[local / kChunk];
+  if (base == kNone) {
+    base = static_cast<uint32_t>(slots_.size());
+    slots_.resize(slots_.size() + kChunk);
+    for (uint32_t i = 0; i < kChunk; ++i) slots_[base + i].key = (key & ~uint64_t{kChunk - 1}) + i;
   }
+  const uint32_t slot = base + local % kChunk;
+  slots_[slot].observed = 1;
   return slot;
 }
 
@@ -145,8 +150,15 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
   const double t = scan.table.time();
   scan_cells_.clear();
   scan_values_.clear();
+  // Two passes: first every key's slot (one brick lookup per run of keys), then the states, with
+  // the slot records fetched a few cells ahead: a scan's slots are cold, and a miss per cell would
+  // cost more than all the arithmetic.
+  scan_slots_.resize(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i) scan_slots_[i] = FindOrAddSlot(keys[i]);
+  constexpr size_t kAhead = 8;
   for (size_t i = 0; i < keys.size(); ++i) {
-    const uint32_t slot = FindOrAddSlot(keys[i]);
+    if (i + kAhead < keys.size()) __builtin_prefetch(&slots_[scan_slots_[i + kAhead]], 1, 3);
+    const uint32_t slot = scan_slots_[i];
     MarkDirty(slot);
     uint32_t d = slots_[slot].dynamic;
     if (d == kNone) {
@@ -226,20 +238,22 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
   const float* cos_f = table.cos_f();
   const float* sin_f = table.sin_f();
-  for (uint32_t bz = box.lo[2] >> 3; bz <= (box.hi[2] - 1) >> 3; ++bz) {
-    for (uint32_t by = box.lo[1] >> 3; by <= (box.hi[1] - 1) >> 3; ++by) {
-      for (uint32_t bx = box.lo[0] >> 3; bx <= (box.hi[0] - 1) >> 3; ++bx) {
-        const auto it = bricks_.find(BrickOf(MortonKey(bx << 3, by << 3, bz << 3)));
+  const std::array<uint32_t, 3> bs = grid_keys_.brick_size();
+  // Brick by brick: one hash lookup per brick, then the cells of the box inside it.
+  for (uint32_t bz = box.lo[2] / bs[2]; bz <= (box.hi[2] - 1) / bs[2]; ++bz) {
+    for (uint32_t by = box.lo[1] / bs[1]; by <= (box.hi[1] - 1) / bs[1]; ++by) {
+      for (uint32_t bx = box.lo[0] / bs[0]; bx <= (box.hi[0] - 1) / bs[0]; ++bx) {
+        const auto it = bricks_.find(BrickOf(grid_keys_.Key(bx * bs[0], by * bs[1], bz * bs[2])));
         if (it == bricks_.end()) continue;
         const Brick& brick = brick_data_[it->second];
-        const uint32_t z0 = std::max(box.lo[2], bz << 3), z1 = std::min(box.hi[2], (bz << 3) + 8);
-        const uint32_t y0 = std::max(box.lo[1], by << 3), y1 = std::min(box.hi[1], (by << 3) + 8);
-        const uint32_t x0 = std::max(box.lo[0], bx << 3), x1 = std::min(box.hi[0], (bx << 3) + 8);
+        const uint32_t z0 = std::max(box.lo[2], bz * bs[2]), z1 = std::min(box.hi[2], (bz + 1) * bs[2]);
+        const uint32_t y0 = std::max(box.lo[1], by * bs[1]), y1 = std::min(box.hi[1], (by + 1) * bs[1]);
+        const uint32_t x0 = std::max(box.lo[0], bx * bs[0]), x1 = std::min(box.hi[0], (bx + 1) * bs[0]);
         for (uint32_t z = z0; z < z1; ++z) {
           for (uint32_t y = y0; y < y1; ++y) {
             float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
             for (uint32_t x = x0; x < x1; ++x) {
-              const uint32_t handle = brick.handles[LocalIndex(x, y, z)];
+              const uint32_t handle = brick.handles[grid_keys_.LocalIndex(x, y, z)];
               if (handle != kNone) row[x] = PredictHandle(handle, table, cos_f, sin_f, options);
             }
           }
@@ -271,10 +285,11 @@ std::optional<StateSnapshot> Shard::Snapshot(uint64_t key) const {
 ShardStats Shard::Stats() const {
   std::shared_lock lock(mutex_);
   ShardStats stats;
-  stats.states = slots_.size();
+  for (const Slot& slot : slots_) stats.states += slot.observed;
   stats.dynamic_states = slot_of_.size();
   stats.order_histogram.assign(settings_.max_order + 1, 0);
   for (size_t slot = 0; slot < slots_.size(); ++slot) {
+    if (!slots_[slot].observed) continue;
     const uint32_t d = slots_[slot].dynamic;
     stats.observations += d == kNone ? slots_[slot].static_state.count() : spectra_.header(d).n;
   }
@@ -297,7 +312,9 @@ ShardStats Shard::Stats() const {
 
 void Shard::ForEachKey(const std::function<void(uint64_t)>& f) const {
   std::shared_lock lock(mutex_);
-  for (const Slot& slot : slots_) f(slot.key);
+  for (const Slot& slot : slots_) {
+    if (slot.observed) f(slot.key);
+  }
 }
 
 void Shard::ForEachLabel(
@@ -340,7 +357,7 @@ absl::Status Shard::Checkpoint(uint64_t lsn, const DedupTable& dedup) {
       const Brick& data = brick_data_[bricks_.at(brick)];
       StaticBrick value;
       for (uint32_t i = 0; i < 512; ++i) {
-        const uint32_t slot = data.slots[i];
+        const uint32_t slot = SlotAt(data, i);
         if (slot != kNone && slots_[slot].dynamic == kNone) value.Add(i, slots_[slot].static_state);
       }
       const auto key = KeyBytes(brick);

@@ -131,12 +131,17 @@ class Shard {
   // A handle says what predicting a cell needs without touching its slot: kNone (unobserved),
   // kStaticHandle | value (never changed), or the dynamic index.
   static constexpr uint32_t kStaticHandle = 0x80000000u;
+  // Slots are allocated 64 at a time per run of 64 keys (a 4×4×4 or 8×8 block), so that the
+  // states of neighbouring cells — what one scan touches — sit together in memory.
+  static constexpr uint32_t kChunk = 64;
   struct Brick {
-    std::array<uint32_t, 512> slots;    // slot of key (brick << 9 | i), or kNone
-    std::array<uint32_t, 512> handles;  // see kStaticHandle
+    std::array<uint32_t, 512> handles;                 // see kStaticHandle
+    std::array<uint32_t, 512 / kChunk> chunk_base;     // first slot of each run of 64 keys, or kNone
   };
 
   uint32_t FindSlot(uint64_t key) const;
+  // The slot of local index i of a brick, or kNone when that cell was never observed.
+  uint32_t SlotAt(const Brick& brick, uint32_t local) const;
   // The brick of a key, created when missing. Consecutive calls for one brick cost no hash lookup.
   Brick& BrickFor(uint64_t key);
   uint32_t FindOrAddSlot(uint64_t key);
@@ -153,6 +158,7 @@ class Shard {
   const MapInfo map_;
   const model::ModelSettings& settings_;
   const bool lossless_;
+  const GridKeys grid_keys_;
   std::unique_ptr<LmdbEnv> env_;
   mutable std::shared_mutex mutex_;
 
@@ -166,7 +172,8 @@ class Shard {
     model::StaticState static_state;
     uint64_t key = 0;
     uint32_t dynamic = kNone;  // kNone while static
-    uint32_t dirty = 0;
+    uint8_t dirty = 0;
+    uint8_t observed = 0;      // a slot of an allocated run whose cell has not been seen is unused
   };
   static_assert(sizeof(Slot) == 32);
   std::vector<Slot> slots_;
@@ -182,6 +189,7 @@ class Shard {
   absl::flat_hash_map<uint64_t, std::pair<std::string, std::string>> labels_;
   std::vector<uint64_t> dirty_labels_;
   // Scratch of Apply.
+  std::vector<uint32_t> scan_slots_;
   std::vector<uint32_t> scan_cells_;
   std::vector<float> scan_values_;
 

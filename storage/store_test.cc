@@ -93,7 +93,7 @@ TEST(StoreTest, BackupUnderLoadRestoresAConsistentMap) {
   for (uint64_t i = 0; i < observations / 64; ++i) ASSERT_TRUE((*reference)->Write(SweepScan(*info, 1, i, 64)).ok());
   for (uint32_t x = 0; x < 32; ++x) {
     for (uint32_t y = 0; y < 32; ++y) {
-      const uint64_t key = MortonKey(x, y, 1);
+      const uint64_t key = info->grid.keys().Key(x, y, 1);
       const auto got = copy->Snapshot(key), want = (*reference)->Snapshot(key);
       ASSERT_EQ(got.has_value(), want.has_value());
       if (got && !got->is_static) {
@@ -167,7 +167,7 @@ TEST(StoreTest, LosslessMapsReconstructThePastExactly) {
     b.time = 1.7e9 + 60.0 * i + 1;
     const bool v = (i / 90) % 3 == 0 || i % 17 == 0;
     truth.push_back(v);
-    b.keys.push_back(MortonKey(1, 2, 0));
+    b.keys.push_back(info.grid.keys().Key(1, 2, 0));
     b.values.push_back(v ? 1.0f : 0.0f);
     ASSERT_TRUE(map->Write(b).ok());
   }
@@ -175,10 +175,10 @@ TEST(StoreTest, LosslessMapsReconstructThePastExactly) {
   early.writer_id = 2;
   early.sequence = 1;
   early.time = 1.7e9 - 1;
-  early.keys.push_back(MortonKey(1, 2, 0));
+  early.keys.push_back(info.grid.keys().Key(1, 2, 0));
   early.values.push_back(1);
   EXPECT_TRUE(absl::IsInvalidArgument(map->Submit(early, [](auto) {})));
-  const auto snapshot = map->Snapshot(MortonKey(1, 2, 0));
+  const auto snapshot = map->Snapshot(info.grid.keys().Key(1, 2, 0));
   ASSERT_TRUE(snapshot && snapshot->lossless);
   auto past = snapshot->lossless->Reconstruct(0, truth.size());
   ASSERT_TRUE(past.ok());

@@ -37,7 +37,7 @@ inline ObservationBatch SweepScan(const MapInfo& map, uint64_t writer, uint64_t 
     const uint32_t x = ux(rng), y = uy(rng), z = uz(rng);
     const bool dynamic = x % 7 == 0;
     const bool occupied = dynamic && ((day_phase > 0.3 && day_phase < 0.7) != noise(rng));
-    b.keys.push_back(MortonKey(x, y, z));
+    b.keys.push_back(map.grid.keys().Key(x, y, z));
     b.values.push_back(occupied ? 1.0f : 0.0f);
   }
   return b;
