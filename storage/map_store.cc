@@ -111,6 +111,7 @@ absl::Status MapStore::Recover() {
   if (!replayed.ok()) return replayed.status();
   WalOptions wal_options;
   wal_options.segment_bytes = options_.log_segment_bytes;
+  wal_options.inject_fault = options_.inject_log_fault;
   auto wal = WalWriter::Open(dir_ + "/wal", wal_options);
   if (!wal.ok()) return wal.status();
   wal_ = *std::move(wal);

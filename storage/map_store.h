@@ -48,6 +48,8 @@ struct StoreOptions {
   // Observations queued but not yet applied beyond which Submit refuses (ResourceExhausted).
   // Default: 16M (about 100 MB of queued scans).
   uint64_t max_queued_observations = 16ull << 20;
+  // Fault injection for tests (see WalOptions::inject_fault). Default: none.
+  std::function<absl::Status()> inject_log_fault;
 };
 
 struct MapStats {

@@ -241,8 +241,8 @@ uint64_t WalWriter::Append(std::span<const uint8_t> payload) {
 absl::Status WalWriter::Sync() {
   if (!latched_.ok()) return latched_;
   if (buffer_.empty()) return absl::OkStatus();
-  absl::Status status;
-  if (segment_size_ >= options_.segment_bytes) status = OpenSegment(first_buffered_lsn_);
+  absl::Status status = options_.inject_fault ? options_.inject_fault() : absl::OkStatus();
+  if (status.ok() && segment_size_ >= options_.segment_bytes) status = OpenSegment(first_buffered_lsn_);
   size_t written = 0;
   while (status.ok() && written < buffer_.size()) {
     const ssize_t n = write(fd_, buffer_.data() + written, buffer_.size() - written);

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -28,6 +29,9 @@ struct WalOptions {
   // A new segment starts once the current one passes this size; checkpoints delete whole
   // segments, so smaller segments free space sooner at the cost of more files. Default: 64 MiB.
   uint64_t segment_bytes = 64ull << 20;
+  // Fault injection for tests: called before each write+sync; an error is treated exactly like a
+  // failed write (it latches). Default: none.
+  std::function<absl::Status()> inject_fault;
 };
 
 struct WalReplayResult {
