@@ -18,7 +18,7 @@ std::span<const uint8_t> Bytes(std::string_view s) { return {reinterpret_cast<co
 std::string_view View(std::span<const uint8_t> b) { return {reinterpret_cast<const char*>(b.data()), b.size()}; }
 
 absl::Status PutMap(LmdbTxn& txn, const MapInfo& info) {
-  auto maps = txn.OpenDb(kMapsDb, true);
+  auto maps = txn.Db(kMapsDb);
   if (!maps.ok()) return maps.status();
   const std::string encoded = EncodeMapInfo(info);
   const absl::Status put = txn.Put(*maps, Bytes(info.name), Bytes(encoded), MDB_NOOVERWRITE);
@@ -33,6 +33,7 @@ absl::Status PutMap(LmdbTxn& txn, const MapInfo& info) {
 absl::StatusOr<std::unique_ptr<Catalog>> Catalog::Open(const std::string& dir) {
   LmdbOptions options;
   options.initial_map_size = 16ull << 20;
+  options.databases = {kMapsDb, kMetaDb};
   auto env = LmdbEnv::Open(dir, options);
   if (!env.ok()) return env.status();
   return std::unique_ptr<Catalog>(new Catalog(*std::move(env)));
@@ -43,7 +44,7 @@ absl::StatusOr<MapInfo> Catalog::Create(MapInfo info, uint32_t default_shards) {
   if (absl::Status valid = ValidateMapInfo(info); !valid.ok()) return valid;
   info.created_unix = std::time(nullptr);
   const absl::Status written = env_->Write([&](LmdbTxn& txn) -> absl::Status {
-    auto meta = txn.OpenDb(kMetaDb, true);
+    auto meta = txn.Db(kMetaDb);
     if (!meta.ok()) return meta.status();
     uint64_t next_id = 1;
     if (auto stored = txn.Get(*meta, Bytes("next_id")); stored.ok() && stored->size() == 8) {
@@ -68,7 +69,7 @@ absl::Status Catalog::Restore(const MapInfo& info) {
 absl::StatusOr<MapInfo> Catalog::Get(const std::string& name) const {
   absl::StatusOr<MapInfo> result = absl::NotFoundError(absl::StrCat("no map named \"", name, "\""));
   const absl::Status read = env_->Read([&](LmdbTxn& txn) -> absl::Status {
-    auto maps = txn.OpenDb(kMapsDb, false);
+    auto maps = txn.Db(kMapsDb);
     if (absl::IsNotFound(maps.status())) return absl::OkStatus();
     if (!maps.ok()) return maps.status();
     auto value = txn.Get(*maps, Bytes(name));
@@ -96,7 +97,7 @@ absl::StatusOr<MapPage> Catalog::List(size_t page_size, const std::string& page_
   MapPage page;
   absl::Status decode_error;
   const absl::Status read = env_->Read([&](LmdbTxn& txn) -> absl::Status {
-    auto maps = txn.OpenDb(kMapsDb, false);
+    auto maps = txn.Db(kMapsDb);
     if (absl::IsNotFound(maps.status())) return absl::OkStatus();
     if (!maps.ok()) return maps.status();
     bool more = false;
@@ -124,7 +125,7 @@ absl::StatusOr<MapPage> Catalog::List(size_t page_size, const std::string& page_
 
 absl::Status Catalog::Delete(const std::string& name) {
   return env_->Write([&](LmdbTxn& txn) -> absl::Status {
-    auto maps = txn.OpenDb(kMapsDb, true);
+    auto maps = txn.Db(kMapsDb);
     if (!maps.ok()) return maps.status();
     if (auto existing = txn.Get(*maps, Bytes(name)); !existing.ok()) {
       return absl::IsNotFound(existing.status()) ? absl::NotFoundError(absl::StrCat("no map named \"", name, "\""))

@@ -192,10 +192,12 @@ TEST(MapStoreTest, CorruptedRecordIsDataLossNotACrash) {
     for (uint64_t i = 0; i < 100; ++i) ASSERT_TRUE(store->Write(SweepScan(map, 1, i, 100)).ok());
   }
   {
-    auto env = LmdbEnv::Open(dir.path() + "/shard-0", {});
+    LmdbOptions options;
+    options.databases = {"dynamic"};
+    auto env = LmdbEnv::Open(dir.path() + "/shard-0", options);
     ASSERT_TRUE(env.ok());
     ASSERT_TRUE((*env)->Write([](LmdbTxn& txn) -> absl::Status {
-      auto db = txn.OpenDb("dynamic", false);
+      auto db = txn.Db("dynamic");
       if (!db.ok()) return db.status();
       std::vector<std::pair<std::vector<uint8_t>, std::vector<uint8_t>>> damaged;
       (void)txn.Scan(*db, {}, {}, [&](auto k, auto v) {

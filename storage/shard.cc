@@ -43,7 +43,9 @@ Shard::Shard(const MapInfo& map, const model::ModelSettings& settings, std::uniq
 
 absl::StatusOr<std::unique_ptr<Shard>> Shard::Open(const MapInfo& map, const model::ModelSettings& settings,
                                                    const std::string& dir, const LmdbOptions& options) {
-  auto env = LmdbEnv::Open(dir, options);
+  LmdbOptions with_databases = options;
+  with_databases.databases = {kStaticDb, kDynamicDb, kLosslessDb, kLabelsDb, kMetaDb};
+  auto env = LmdbEnv::Open(dir, with_databases);
   if (!env.ok()) return env.status();
   auto shard = std::unique_ptr<Shard>(new Shard(map, settings, *std::move(env)));
   if (absl::Status loaded = shard->Load(); !loaded.ok()) return loaded;
@@ -333,11 +335,11 @@ absl::Status Shard::Checkpoint(uint64_t lsn, const DedupTable& dedup) {
     if (dirty_bricks.empty() || dirty_bricks.back() != brick) dirty_bricks.push_back(brick);
   }
   const absl::Status written = env_->Write([&](LmdbTxn& txn) -> absl::Status {
-    auto static_db = txn.OpenDb(kStaticDb, true);
-    auto dynamic_db = txn.OpenDb(kDynamicDb, true);
-    auto lossless_db = txn.OpenDb(kLosslessDb, true);
-    auto labels_db = txn.OpenDb(kLabelsDb, true);
-    auto meta_db = txn.OpenDb(kMetaDb, true);
+    auto static_db = txn.Db(kStaticDb);
+    auto dynamic_db = txn.Db(kDynamicDb);
+    auto lossless_db = txn.Db(kLosslessDb);
+    auto labels_db = txn.Db(kLabelsDb);
+    auto meta_db = txn.Db(kMetaDb);
     for (auto* db : {&static_db, &dynamic_db, &lossless_db, &labels_db, &meta_db}) {
       if (!db->ok()) return db->status();
     }
@@ -391,7 +393,7 @@ absl::Status Shard::Checkpoint(uint64_t lsn, const DedupTable& dedup) {
 
 absl::Status Shard::Load() {
   return env_->Read([&](LmdbTxn& txn) -> absl::Status {
-    auto meta_db = txn.OpenDb(kMetaDb, false);
+    auto meta_db = txn.Db(kMetaDb);
     if (absl::IsNotFound(meta_db.status())) return absl::OkStatus();  // a new shard
     if (!meta_db.ok()) return meta_db.status();
     if (auto lsn = txn.Get(*meta_db, Bytes(kLsnKey)); lsn.ok()) {
@@ -405,7 +407,7 @@ absl::Status Shard::Load() {
     }
     absl::Status failure;
     const auto scan = [&](const char* family, const std::function<absl::Status(uint64_t, std::string_view)>& f) {
-      auto db = txn.OpenDb(family, false);
+      auto db = txn.Db(family);
       if (absl::IsNotFound(db.status())) return absl::OkStatus();
       if (!db.ok()) return db.status();
       absl::Status scanned = txn.Scan(*db, {}, {}, [&](auto key, auto value) {

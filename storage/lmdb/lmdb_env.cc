@@ -35,11 +35,26 @@ absl::Status LmdbStatus(int rc, absl::string_view what) {
   }
 }
 
-absl::StatusOr<MDB_dbi> LmdbTxn::OpenDb(const char* name, bool create) {
-  MDB_dbi dbi;
-  const int rc = mdb_dbi_open(txn_, name, create ? MDB_CREATE : 0, &dbi);
-  if (rc != MDB_SUCCESS) return LmdbStatus(rc, absl::StrCat("mdb_dbi_open ", name ? name : "(main)"));
-  return dbi;
+absl::StatusOr<MDB_dbi> LmdbTxn::Db(const std::string& name) const {
+  const auto it = dbs_->find(name);
+  if (it == dbs_->end()) return absl::InvalidArgumentError(absl::StrCat("database ", name, " was not declared"));
+  return it->second;
+}
+
+absl::Status LmdbEnv::OpenDatabases(const std::vector<std::string>& names) {
+  MDB_txn* txn;
+  int rc = mdb_txn_begin(env_, nullptr, 0, &txn);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin");
+  for (const std::string& name : names) {
+    MDB_dbi dbi;
+    rc = mdb_dbi_open(txn, name.c_str(), MDB_CREATE, &dbi);
+    if (rc != MDB_SUCCESS) {
+      mdb_txn_abort(txn);
+      return LmdbStatus(rc, absl::StrCat("mdb_dbi_open ", name));
+    }
+    dbs_[name] = dbi;
+  }
+  return LmdbStatus(mdb_txn_commit(txn), "mdb_txn_commit (databases)");
 }
 
 absl::Status LmdbTxn::Put(MDB_dbi dbi, std::span<const uint8_t> key, std::span<const uint8_t> value,
@@ -115,6 +130,7 @@ absl::StatusOr<std::unique_ptr<LmdbEnv>> LmdbEnv::Open(const std::string& dir, c
   auto result = std::unique_ptr<LmdbEnv>(new LmdbEnv(env, dir, info.me_mapsize));
   int dead = 0;
   mdb_reader_check(env, &dead);  // slots of processes killed while reading
+  if (absl::Status s = result->OpenDatabases(options.databases); !s.ok()) return s;
   return result;
 }
 
@@ -149,7 +165,7 @@ absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {
       std::shared_lock lock(resize_);
       rc = mdb_txn_begin(env_, nullptr, 0, &txn);
       if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin");
-      LmdbTxn wrapped(txn);
+      LmdbTxn wrapped(txn, &dbs_);
       absl::Status status = f(wrapped);
       if (!status.ok()) {
         mdb_txn_abort(txn);
@@ -175,7 +191,7 @@ absl::Status LmdbEnv::Read(const std::function<absl::Status(LmdbTxn&)>& f) const
   MDB_txn* txn;
   const int rc = mdb_txn_begin(env_, nullptr, MDB_RDONLY, &txn);
   if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin (read)");
-  LmdbTxn wrapped(txn);
+  LmdbTxn wrapped(txn, &dbs_);
   absl::Status status = f(wrapped);
   mdb_txn_abort(txn);
   return status;

@@ -25,6 +25,9 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
+
+#include "absl/container/flat_hash_map.h"
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -46,6 +49,9 @@ struct LmdbOptions {
   // Skip fsync at commit: only for data whose durability comes from elsewhere (the write-ahead
   // log) and that is synced explicitly with Sync() before the log is trimmed. Default: false.
   bool no_sync = false;
+  // The named databases used in this environment. They are created (when missing) and their
+  // handles opened once, at Open: LMDB forbids opening handles in concurrent transactions.
+  std::vector<std::string> databases;
 };
 
 // A byte view of an LMDB value, valid until its transaction ends.
@@ -56,13 +62,15 @@ inline MDB_val AsVal(std::span<const uint8_t> bytes) {
   return {bytes.size(), const_cast<uint8_t*>(bytes.data())};
 }
 
+using DbHandles = absl::flat_hash_map<std::string, MDB_dbi>;
+
 class LmdbTxn {
  public:
-  explicit LmdbTxn(MDB_txn* txn) : txn_(txn) {}
+  LmdbTxn(MDB_txn* txn, const DbHandles* dbs) : txn_(txn), dbs_(dbs) {}
   MDB_txn* get() const { return txn_; }
 
-  // The named database (created in write transactions when missing).
-  absl::StatusOr<MDB_dbi> OpenDb(const char* name, bool create);
+  // A database declared in LmdbOptions::databases; InvalidArgument for an undeclared name.
+  absl::StatusOr<MDB_dbi> Db(const std::string& name) const;
   absl::Status Put(MDB_dbi dbi, std::span<const uint8_t> key, std::span<const uint8_t> value, unsigned flags = 0);
   // NotFound when absent; the view is valid until the transaction ends.
   absl::StatusOr<std::span<const uint8_t>> Get(MDB_dbi dbi, std::span<const uint8_t> key) const;
@@ -80,6 +88,7 @@ class LmdbTxn {
 
  private:
   MDB_txn* txn_;
+  const DbHandles* dbs_;
   bool map_full_ = false;
 };
 
@@ -114,6 +123,7 @@ class LmdbEnv {
  private:
   LmdbEnv(MDB_env* env, std::string dir, size_t map_size) : env_(env), dir_(std::move(dir)), map_size_(map_size) {}
   absl::Status Grow();
+  absl::Status OpenDatabases(const std::vector<std::string>& names);
   void Latch(const absl::Status& status);
 
   MDB_env* env_;
@@ -123,6 +133,7 @@ class LmdbEnv {
   mutable std::shared_mutex resize_;     // readers shared, map growth exclusive
   mutable std::mutex latch_mutex_;
   absl::Status latched_;
+  DbHandles dbs_;  // written once, at Open
 };
 
 }  // namespace fremen::storage

@@ -11,6 +11,12 @@
 namespace fremen::storage {
 namespace {
 
+LmdbOptions Cells() {
+  LmdbOptions options;
+  options.databases = {"cells"};
+  return options;
+}
+
 std::vector<uint8_t> Key(uint64_t i) {
   std::vector<uint8_t> k(8);
   for (int b = 0; b < 8; ++b) k[b] = static_cast<uint8_t>(i >> (56 - 8 * b));  // big-endian: sorted
@@ -19,14 +25,14 @@ std::vector<uint8_t> Key(uint64_t i) {
 
 TEST(LmdbEnvTest, GrowsTheMapInsteadOfFailingWrites) {
   testing::TempDir dir;
-  LmdbOptions options;
+  LmdbOptions options = Cells();
   options.initial_map_size = 64 << 10;  // 64 KiB: full after a few pages
   auto env = LmdbEnv::Open(dir.path(), options);
   ASSERT_TRUE(env.ok()) << env.status();
   const std::vector<uint8_t> value(1000, 0xAB);
   for (int round = 0; round < 10; ++round) {
     ASSERT_TRUE((*env)->Write([&](LmdbTxn& txn) -> absl::Status {
-      auto dbi = txn.OpenDb("cells", true);
+      auto dbi = txn.Db("cells");
       if (!dbi.ok()) return dbi.status();
       for (uint64_t i = 0; i < 1000; ++i) {
         if (auto s = txn.Put(*dbi, Key(round * 1000 + i), value); !s.ok()) return s;
@@ -37,7 +43,7 @@ TEST(LmdbEnvTest, GrowsTheMapInsteadOfFailingWrites) {
   EXPECT_GT((*env)->map_size(), 10u * 1000 * 1000);
   size_t count = 0;
   ASSERT_TRUE((*env)->Read([&](LmdbTxn& txn) -> absl::Status {
-    auto dbi = txn.OpenDb("cells", false);
+    auto dbi = txn.Db("cells");
     if (!dbi.ok()) return dbi.status();
     auto n = txn.Count(*dbi);
     if (!n.ok()) return n.status();
@@ -49,10 +55,10 @@ TEST(LmdbEnvTest, GrowsTheMapInsteadOfFailingWrites) {
 
 TEST(LmdbEnvTest, ScanVisitsAKeyRangeInOrder) {
   testing::TempDir dir;
-  auto env = LmdbEnv::Open(dir.path(), {});
+  auto env = LmdbEnv::Open(dir.path(), Cells());
   ASSERT_TRUE(env.ok());
   ASSERT_TRUE((*env)->Write([&](LmdbTxn& txn) -> absl::Status {
-    auto dbi = txn.OpenDb("cells", true);
+    auto dbi = txn.Db("cells");
     for (uint64_t i = 0; i < 100; ++i) {
       if (auto s = txn.Put(*dbi, Key(i * 10), Key(i)); !s.ok()) return s;
     }
@@ -60,7 +66,7 @@ TEST(LmdbEnvTest, ScanVisitsAKeyRangeInOrder) {
   }).ok());
   std::vector<uint64_t> seen;
   ASSERT_TRUE((*env)->Read([&](LmdbTxn& txn) -> absl::Status {
-    auto dbi = txn.OpenDb("cells", false);
+    auto dbi = txn.Db("cells");
     return txn.Scan(*dbi, Key(205), Key(300), [&](auto, std::span<const uint8_t> v) {
       seen.push_back(v[7]);
       return true;
@@ -71,17 +77,17 @@ TEST(LmdbEnvTest, ScanVisitsAKeyRangeInOrder) {
 
 TEST(LmdbEnvTest, AFailingTransactionLeavesNothingBehind) {
   testing::TempDir dir;
-  auto env = LmdbEnv::Open(dir.path(), {});
+  auto env = LmdbEnv::Open(dir.path(), Cells());
   ASSERT_TRUE(env.ok());
   const absl::Status failed = (*env)->Write([&](LmdbTxn& txn) -> absl::Status {
-    auto dbi = txn.OpenDb("cells", true);
+    auto dbi = txn.Db("cells");
     if (auto s = txn.Put(*dbi, Key(1), Key(1)); !s.ok()) return s;
     return absl::InvalidArgumentError("changed my mind");
   });
   EXPECT_TRUE(absl::IsInvalidArgument(failed));
   EXPECT_TRUE((*env)->health().ok());  // a caller's error is not a storage failure
   const absl::Status read = (*env)->Read([&](LmdbTxn& txn) -> absl::Status {
-    auto dbi = txn.OpenDb("cells", false);
+    auto dbi = txn.Db("cells");
     if (!dbi.ok()) return dbi.status();
     return txn.Get(*dbi, Key(1)).status();
   });
@@ -90,7 +96,7 @@ TEST(LmdbEnvTest, AFailingTransactionLeavesNothingBehind) {
 
 TEST(LmdbEnvTest, ReadersRunConcurrentlyWithAGrowingWriter) {
   testing::TempDir dir;
-  LmdbOptions options;
+  LmdbOptions options = Cells();
   options.initial_map_size = 64 << 10;
   auto env = LmdbEnv::Open(dir.path(), options);
   ASSERT_TRUE(env.ok());
@@ -99,7 +105,7 @@ TEST(LmdbEnvTest, ReadersRunConcurrentlyWithAGrowingWriter) {
   std::thread reader([&] {
     while (!done) {
       (void)(*env)->Read([&](LmdbTxn& txn) -> absl::Status {
-        auto dbi = txn.OpenDb("cells", false);
+        auto dbi = txn.Db("cells");
         if (!dbi.ok()) return dbi.status();
         auto n = txn.Count(*dbi);
         if (n.ok()) {
@@ -113,7 +119,7 @@ TEST(LmdbEnvTest, ReadersRunConcurrentlyWithAGrowingWriter) {
   const std::vector<uint8_t> value(500, 1);
   for (uint64_t i = 0; i < 200; ++i) {
     ASSERT_TRUE((*env)->Write([&](LmdbTxn& txn) -> absl::Status {
-      auto dbi = txn.OpenDb("cells", true);
+      auto dbi = txn.Db("cells");
       for (uint64_t j = 0; j < 50; ++j) {
         if (auto s = txn.Put(*dbi, Key(i * 50 + j), value); !s.ok()) return s;
       }
@@ -127,17 +133,17 @@ TEST(LmdbEnvTest, ReadersRunConcurrentlyWithAGrowingWriter) {
 
 TEST(LmdbEnvTest, CopyIsAConsistentEnvironment) {
   testing::TempDir dir;
-  auto env = LmdbEnv::Open(dir.path() + "/a", {});
+  auto env = LmdbEnv::Open(dir.path() + "/a", Cells());
   ASSERT_TRUE(env.ok());
   ASSERT_TRUE((*env)->Write([&](LmdbTxn& txn) -> absl::Status {
-    auto dbi = txn.OpenDb("cells", true);
+    auto dbi = txn.Db("cells");
     return txn.Put(*dbi, Key(7), Key(42));
   }).ok());
   ASSERT_TRUE((*env)->CopyTo(dir.path() + "/b").ok());
-  auto copy = LmdbEnv::Open(dir.path() + "/b", {});
+  auto copy = LmdbEnv::Open(dir.path() + "/b", Cells());
   ASSERT_TRUE(copy.ok());
   ASSERT_TRUE((*copy)->Read([&](LmdbTxn& txn) -> absl::Status {
-    auto dbi = txn.OpenDb("cells", false);
+    auto dbi = txn.Db("cells");
     auto v = txn.Get(*dbi, Key(7));
     if (!v.ok()) return v.status();
     EXPECT_EQ((*v)[7], 42);
@@ -153,7 +159,7 @@ TEST(LmdbEnvTest, OpeningAGarbageFileIsAnErrorNotACrash) {
     std::fwrite(junk.data(), 1, junk.size(), f);
     std::fclose(f);
   }
-  auto env = LmdbEnv::Open(dir.path(), {});
+  auto env = LmdbEnv::Open(dir.path(), Cells());
   EXPECT_FALSE(env.ok());
 }
 

@@ -12,6 +12,7 @@
 // before the writer opens.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <functional>
@@ -60,9 +61,10 @@ class WalWriter {
   absl::Status DropThrough(uint64_t lsn);
 
   uint64_t last_lsn() const { return next_lsn_ - 1; }
-  uint64_t durable_lsn() const { return durable_lsn_; }
+  // These two may be read from any thread (for statistics).
+  uint64_t durable_lsn() const { return durable_lsn_.load(std::memory_order_relaxed); }
   // Bytes in all live segments.
-  uint64_t bytes() const { return bytes_; }
+  uint64_t bytes() const { return bytes_.load(std::memory_order_relaxed); }
 
  private:
   WalWriter(std::string dir, WalOptions options) : dir_(std::move(dir)), options_(options) {}
@@ -73,8 +75,8 @@ class WalWriter {
   int fd_ = -1;
   uint64_t segment_size_ = 0;
   uint64_t next_lsn_ = 1;
-  uint64_t durable_lsn_ = 0;
-  uint64_t bytes_ = 0;
+  std::atomic<uint64_t> durable_lsn_ = 0;
+  std::atomic<uint64_t> bytes_ = 0;
   std::vector<uint8_t> buffer_;
   uint64_t first_buffered_lsn_ = 0;
   struct Segment {
