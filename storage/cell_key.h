@@ -86,10 +86,7 @@ class GridKeys {
     return {static_cast<uint32_t>(CompactBits2(key)), static_cast<uint32_t>(CompactBits2(key >> 1)), 0};
   }
   // Whether `key` is the key of some cell at all (the 2-D code uses 42 bits, the 3-D one 63).
-  bool IsCellKey(uint64_t key) const {
-    const auto c = Cell(key);
-    return c[0] <= kMaxGridIndex && c[1] <= kMaxGridIndex && Key(c[0], c[1], c[2]) == key;
-  }
+  bool IsCellKey(uint64_t key) const { return key >> (flat_ ? 2 * kMortonBitsPerAxis : 3 * kMortonBitsPerAxis) == 0; }
   // Cells along x, y, z of one brick: 32×16×1 (2-D) or 8×8×8 (3-D).
   std::array<uint32_t, 3> brick_size() const {
     return flat_ ? std::array<uint32_t, 3>{32, 16, 1} : std::array<uint32_t, 3>{8, 8, 8};

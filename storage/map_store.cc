@@ -427,6 +427,10 @@ MapStats MapStore::Stats() const {
     stats.totals.memory_bytes += s.memory_bytes;
     stats.totals.prediction_error_sum += s.prediction_error_sum;
     stats.totals.prediction_error_states += s.prediction_error_states;
+    stats.totals.estimation_wrong += s.estimation_wrong;
+    stats.totals.estimation_observed += s.estimation_observed;
+    stats.totals.lossless_prediction_wrong += s.lossless_prediction_wrong;
+    stats.totals.lossless_prediction_observed += s.lossless_prediction_observed;
     for (size_t l = 0; l < s.order_histogram.size(); ++l) stats.totals.order_histogram[l] += s.order_histogram[l];
   }
   {
@@ -436,6 +440,13 @@ MapStats MapStore::Stats() const {
   }
   if (stats.totals.disk_bytes > 0) {
     stats.compression_ratio = static_cast<double>(stats.totals.observations) / 8.0 / stats.totals.disk_bytes;
+  }
+  if (stats.totals.estimation_observed > 0) {
+    stats.estimation_error = static_cast<double>(stats.totals.estimation_wrong) / stats.totals.estimation_observed;
+  }
+  if (stats.totals.lossless_prediction_observed > 0) {
+    stats.lossless_prediction_error =
+        static_cast<double>(stats.totals.lossless_prediction_wrong) / stats.totals.lossless_prediction_observed;
   }
   if (stats.totals.prediction_error_states > 0) {
     stats.mean_prediction_error = stats.totals.prediction_error_sum / stats.totals.prediction_error_states;

@@ -60,6 +60,9 @@ struct MapStats {
   double compression_ratio = 0;
   // Mean ε_p (decayed prequential error at the selected order) over dynamic states with evidence.
   double mean_prediction_error = 0;
+  // Lossless maps: ε_e and ε_p over all observed slots of all states (eq. 15).
+  double estimation_error = 0;
+  double lossless_prediction_error = 0;
 };
 
 class MapStore {

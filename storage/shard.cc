@@ -80,6 +80,12 @@ Shard::Brick& Shard::BrickFor(uint64_t key) {
 }
 
 uint32_t Shard::FindOrAddSlot(uint64_t key) {
+  const uint32_t slot = ReserveSlot(key);
+  slots_[slot].observed = 1;
+  return slot;
+}
+
+uint32_t Shard::ReserveSlot(uint64_t key) {
   const uint32_t local = key & 511;
   uint32_t& base = BrickFor(key).chunk_base[local / kChunk];
   if (base == kNone) {
@@ -87,9 +93,7 @@ uint32_t Shard::FindOrAddSlot(uint64_t key) {
     slots_.resize(slots_.size() + kChunk);
     for (uint32_t i = 0; i < kChunk; ++i) slots_[base + i].key = (key & ~uint64_t{kChunk - 1}) + i;
   }
-  const uint32_t slot = base + local % kChunk;
-  slots_[slot].observed = 1;
-  return slot;
+  return base + local % kChunk;
 }
 
 void Shard::MarkDirty(uint32_t slot) {
@@ -156,11 +160,12 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
   // the slot records fetched a few cells ahead: a scan's slots are cold, and a miss per cell would
   // cost more than all the arithmetic.
   scan_slots_.resize(keys.size());
-  for (size_t i = 0; i < keys.size(); ++i) scan_slots_[i] = FindOrAddSlot(keys[i]);
+  for (size_t i = 0; i < keys.size(); ++i) scan_slots_[i] = ReserveSlot(keys[i]);
   constexpr size_t kAhead = 8;
   for (size_t i = 0; i < keys.size(); ++i) {
     if (i + kAhead < keys.size()) __builtin_prefetch(&slots_[scan_slots_[i + kAhead]], 1, 3);
     const uint32_t slot = scan_slots_[i];
+    slots_[slot].observed = 1;
     MarkDirty(slot);
     uint32_t d = slots_[slot].dynamic;
     if (d == kNone) {
@@ -303,6 +308,14 @@ ShardStats Shard::Stats() const {
       stats.prediction_error_sum += errors.ErrorRate(h.order);
       stats.prediction_error_states++;
     }
+  }
+  for (const model::LosslessHistory& history : lossless_histories_) {
+    const auto estimation = history.EstimationError();
+    const auto prediction = history.PredictionError();
+    stats.estimation_wrong += estimation.wrong;
+    stats.estimation_observed += estimation.observed;
+    stats.lossless_prediction_wrong += prediction.wrong;
+    stats.lossless_prediction_observed += prediction.observed;
   }
   stats.memory_bytes = spectra_.bytes() + models_.bytes() + errors_.bytes() +
                        persistence_.capacity() * sizeof(model::Persistence) +

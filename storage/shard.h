@@ -84,6 +84,10 @@ struct ShardStats {
   std::vector<uint64_t> order_histogram;  // selected order of dynamic published states, 0..L
   double prediction_error_sum = 0;        // Σ ε_p(selected order) over dynamic states with evidence
   uint64_t prediction_error_states = 0;
+  // Lossless maps (eq. 15 from the outlier sets): wrong and observed slots, over all history (ε_e)
+  // and since the last update (ε_p).
+  uint64_t estimation_wrong = 0, estimation_observed = 0;
+  uint64_t lossless_prediction_wrong = 0, lossless_prediction_observed = 0;
 };
 
 // The value an unobserved state predicts: no information either way.
@@ -145,6 +149,8 @@ class Shard {
   // The brick of a key, created when missing. Consecutive calls for one brick cost no hash lookup.
   Brick& BrickFor(uint64_t key);
   uint32_t FindOrAddSlot(uint64_t key);
+  // The slot a key has or will have (allocating its run of 64), without touching the slot itself.
+  uint32_t ReserveSlot(uint64_t key);
   void SetHandle(uint64_t key, uint32_t handle) { BrickFor(key).handles[key & 511] = handle; }
   uint32_t Promote(uint32_t slot);  // static → dynamic; returns the dynamic index
   uint32_t AddDynamic(uint32_t slot);

@@ -185,6 +185,9 @@ TEST(StoreTest, LosslessMapsReconstructThePastExactly) {
   for (size_t i = 0; i < truth.size(); ++i) {
     ASSERT_EQ((*past)[i] == model::SlotState::kOccupied, truth[i] == 1) << i;
   }
+  // ε_e from the outlier set: before any update P predicts 0, so every occupied slot is an outlier.
+  const double occupied = std::count(truth.begin(), truth.end(), 1);
+  EXPECT_NEAR(map->Stats().estimation_error, occupied / truth.size(), 1e-12);
 }
 
 }  // namespace
