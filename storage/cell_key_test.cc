@@ -81,3 +81,19 @@ TEST(GridKeysTest, FlatGridsUseDenseTwoDimensionalKeys) {
 
 }  // namespace
 }  // namespace fremen::storage
+
+#include "storage/state_names.h"
+
+namespace fremen::storage {
+namespace {
+
+TEST(StateNamesTest, NamesMapToStableDistinctIds) {
+  EXPECT_EQ(StateIdOfName(""), 0xcbf29ce484222325ull);   // FNV-1a's offset basis
+  EXPECT_EQ(StateIdOfName("a"), 0xaf63dc4c8601ec8cull);  // the published FNV-1a 64 test vector
+  std::set<uint64_t> ids;
+  for (int i = 0; i < 100000; ++i) ids.insert(StateIdOfName("door" + std::to_string(i)));
+  EXPECT_EQ(ids.size(), 100000u);
+}
+
+}  // namespace
+}  // namespace fremen::storage
