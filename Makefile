@@ -1,11 +1,15 @@
 # The two commands of the quick start, and a few more for developers.
-#   make run    build, then run the main job (until the daemon lands: the offline accuracy
-#               evaluation on generated data)
+#   make run    build, then run fremend in the foreground with its embedded defaults: gRPC on
+#               127.0.0.1:50051, data in ./fremen-data (gitignored); Ctrl-C stops it cleanly.
+#               Settings: make run ARGS="--listen 127.0.0.1:6000 --log-level debug"
 #   make test   install what is missing, build, run every test
+#   make demo-eval  the offline accuracy evaluation of the model on generated data
 BUILD ?= build
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps configure build run test bench asan tsan clean
+ARGS ?=
+
+.PHONY: all deps configure build run demo-eval test bench asan tsan clean
 
 all: build
 
@@ -19,6 +23,9 @@ build: configure
 	@cmake --build $(BUILD) -j$(JOBS)
 
 run: build
+	@$(BUILD)/bin/fremend $(ARGS)
+
+demo-eval: build
 	@bash scripts/run-demo-eval.sh $(BUILD)/bin
 
 test: build

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The demo of `make run` until the daemon exists: generates a small synthetic dataset and prints
+# The demo of `make demo-eval`: generates a small synthetic dataset and prints
 # the offline accuracy of the FreMEn model on it, per model order.
 #
 #   scripts/run-demo-eval.sh <bin-dir>

@@ -1,0 +1,22 @@
+#include "server/access_log.h"
+
+#include <spdlog/spdlog.h>
+
+#include "server/status_convert.h"
+
+namespace fremen::server {
+
+void CallRecord::Finish(const grpc::Status& status) const {
+  static const std::shared_ptr<spdlog::logger> logger = spdlog::get(kAccessLogger);
+  if (logger == nullptr) return;  // logging not set up (unit tests)
+  const double ms = absl::ToDoubleMilliseconds(absl::Now() - start_);
+  const fmt::string_view method(method_.data(), method_.size());
+  if (status.ok()) {
+    logger->info("{} {} OK {:.2f}ms", method, peer_, ms);
+  } else {
+    logger->info("{} {} {} {:.2f}ms {}", method, peer_, StatusCodeName(status.error_code()), ms,
+                 status.error_message());
+  }
+}
+
+}  // namespace fremen::server

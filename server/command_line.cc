@@ -1,0 +1,69 @@
+#include "server/command_line.h"
+
+#include <map>
+#include <string>
+
+#include "CLI/CLI.hpp"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
+
+namespace fremen::server {
+
+namespace {
+
+std::string FlagOf(absl::string_view key) { return absl::StrCat("--", absl::StrReplaceAll(key, {{"_", "-"}})); }
+
+}  // namespace
+
+CommandLine ParseCommandLine(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app("fremend: the fremen FreMEn map database daemon (gRPC)", "fremend");
+  app.footer(
+      "Settings: embedded defaults, then --config FILE, then these flags (see deploy/fremend.conf.example).\n"
+      "Exit codes: 0 stopped by SIGTERM/SIGINT, 1 failure, 2 bad command line or configuration.");
+  std::string config_file;
+  bool check_config = false;
+  app.add_option("--config", config_file, "config file of `key = value` lines")->type_name("FILE");
+  app.add_flag("--check-config", check_config, "check the configuration (and the files it names), then exit");
+  app.set_version_flag("--version", FREMEN_VERSION);
+
+  // Flags keep their text until the file has been read: they override it.
+  const ServerConfig defaults;
+  std::map<std::string, std::string> flag_values;
+  std::map<std::string, CLI::Option*> flag_options;
+  for (const ConfigField& field : ConfigFields()) {
+    const std::string key(field.key);
+    CLI::Option* option = app.add_option(FlagOf(key), flag_values[key], std::string(field.help));
+    option->type_name(std::string(field.value_name));
+    if (const std::string value = field.get(defaults); !value.empty()) option->default_str(value);
+    flag_options[key] = option;
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e, out, err);
+    return {std::nullopt, code == 0 ? kExitOk : kExitBadConfig};
+  }
+
+  ServerConfig config;
+  absl::Status status;
+  if (!config_file.empty()) status = ApplyConfigFile(config_file, config);
+  for (const ConfigField& field : ConfigFields()) {
+    if (!status.ok()) break;
+    const std::string key(field.key);
+    if (flag_options[key]->count() == 0) continue;
+    status = SetConfigValue(key, flag_values[key], FlagOf(key), config);
+  }
+  if (status.ok()) status = FinishConfig(config);
+  if (!status.ok()) {
+    err << status.message() << "\n";
+    return {std::nullopt, kExitBadConfig};
+  }
+  if (check_config) {
+    out << "config OK\n";
+    return {std::nullopt, kExitOk};
+  }
+  return {std::move(config), kExitOk};
+}
+
+}  // namespace fremen::server

@@ -1,0 +1,70 @@
+// fremend's life: Start() brings the daemon up step by step, each step checked and logged, and
+// Stop() takes it down in reverse.
+//
+// Start: data directory (created, locked against a second daemon) → credentials → gRPC server listening, health NOT_SERVING → store opened
+// (recovery: every map's checkpoint, then its log) → health SERVING. Calls that arrive during
+// recovery get UNAVAILABLE (server/store_handle.h).
+// Stop: health NOT_SERVING and new calls refused (UNAVAILABLE) → the calls in flight get up to
+// shutdown_grace to finish → gRPC shuts down at once, cancelling what is left → the blocking pool
+// finishes its work → the store finishes queued writes and checkpoints.
+//
+// The services served are added in one place, Daemon::AddServices.
+// Thread-safety: Start and Stop from one thread (main); the services run on gRPC's threads.
+#pragma once
+
+#include <grpcpp/grpcpp.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "server/auth.h"
+#include "server/blocking_pool.h"
+#include "server/call_tracker.h"
+#include "server/config.h"
+#include "server/data_dir_lock.h"
+#include "server/store_handle.h"
+#include "server/unary_call.h"
+#include "storage/store.h"
+
+namespace fremen::server {
+
+class Daemon {
+ public:
+  explicit Daemon(ServerConfig config);
+  ~Daemon();
+
+  // The error names the step that failed. Call Stop() afterwards either way.
+  absl::Status Start();
+  // Idempotent. The error is the store's, when closing it failed (data may not be flushed).
+  absl::Status Stop();
+
+  // HOST:PORT the server listens on (the port chosen, when the config said 0).
+  const std::string& address() const { return address_; }
+
+ private:
+  absl::Status PrepareDirectories();
+  std::shared_ptr<grpc::ServerCredentials> Credentials() const;
+  void AddServices(grpc::ServerBuilder& builder);
+  void SetChannelArguments(grpc::ServerBuilder& builder) const;
+  absl::Status StartServer();
+  absl::Status OpenStore();
+  void SetServing(bool serving);
+
+  ServerConfig config_;
+  CallTracker calls_;
+  Authenticator auth_;
+  BlockingPool blocking_;
+  StoreHandle store_handle_;
+  ServiceDeps deps_;
+  std::unique_ptr<DataDirLock> data_dir_lock_;  // released after the store is closed
+  std::unique_ptr<storage::Store> store_;
+  std::vector<std::unique_ptr<grpc::Service>> services_;
+  std::vector<std::string> service_names_;  // for health: each service, and "" for the whole server
+  std::unique_ptr<grpc::Server> server_;
+  std::string address_;
+  bool stopped_ = false;
+};
+
+}  // namespace fremen::server

@@ -1,0 +1,20 @@
+// fremend's logs: named spdlog loggers on one stderr sink (journald keeps it under systemd):
+//   "fremend"  the daemon's life: start steps, listening address, shutdown;
+//   "access"   one line per RPC (server/access_log.h);
+//   "store"    the store as the daemon sees it: recovery, closing;
+//   "grpc"     gRPC's own messages, routed here instead of its separate format.
+// Set up once at start, before any thread; the loggers are thread-safe.
+#pragma once
+
+#include "absl/strings/string_view.h"
+
+namespace fremen::server {
+
+inline constexpr char kDaemonLogger[] = "fremend";
+inline constexpr char kStoreLogger[] = "store";
+inline constexpr char kGrpcLogger[] = "grpc";
+
+// REQUIRES: `level` is one the config accepts (server/config.h log_level).
+void SetUpLogging(absl::string_view level);
+
+}  // namespace fremen::server

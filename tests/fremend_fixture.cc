@@ -1,0 +1,199 @@
+#include "tests/fremend_fixture.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string_view>
+#include <sstream>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+
+namespace fremen::testing {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr auto kStartTimeout = std::chrono::seconds(60);
+constexpr auto kStopTimeout = std::chrono::seconds(60);
+constexpr auto kPollInterval = std::chrono::milliseconds(20);
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Forks and execs fremend with its output to `log_path`; the child's pid.
+pid_t Spawn(const std::vector<std::string>& args, const std::string& log_path) {
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(FREMEND_BINARY));
+  for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // A test that crashes must not leave its daemon running.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    const int log = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (log < 0) _exit(126);
+    dup2(log, STDOUT_FILENO);
+    dup2(log, STDERR_FILENO);
+    close(log);
+    execv(FREMEND_BINARY, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// The exit code of a waitpid status; -1 for a signal.
+int ExitCodeOf(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
+
+}  // namespace
+
+TempDir::TempDir() {
+  std::string pattern = (fs::temp_directory_path() / "fremen_e2e.XXXXXX").string();
+  if (mkdtemp(pattern.data()) == nullptr) abort();
+  path_ = pattern;
+}
+
+TempDir::~TempDir() {
+  std::error_code ignored;
+  fs::remove_all(path_, ignored);
+}
+
+std::string TempDir::Write(const std::string& name, const std::string& text) const {
+  const std::string path = Path(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+RunResult RunFremend(const std::vector<std::string>& args) {
+  TempDir dir;
+  const std::string log_path = dir.Path("output");
+  const pid_t pid = Spawn(args, log_path);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return {ExitCodeOf(status), ReadFile(log_path)};
+}
+
+absl::StatusOr<std::unique_ptr<FremendProcess>> FremendProcess::Start(
+    const std::string& data_dir, const std::vector<std::string>& args,
+    std::shared_ptr<grpc::ChannelCredentials> credentials) {
+  std::vector<std::string> all_args = {"--listen", "127.0.0.1:0", "--data-dir", data_dir};
+  all_args.insert(all_args.end(), args.begin(), args.end());
+  // The log sits beside the data directory, so that it survives the daemon for the test to read.
+  static int starts = 0;
+  const std::string log_path = absl::StrCat(data_dir, ".fremend-", getpid(), "-", ++starts, ".log");
+  const pid_t pid = Spawn(all_args, log_path);
+  if (pid < 0) return absl::InternalError("fork failed");
+  std::unique_ptr<FremendProcess> process(new FremendProcess(pid, log_path, std::move(credentials)));
+  if (absl::Status serving = process->AwaitServing(); !serving.ok()) {
+    return absl::Status(serving.code(), absl::StrCat(serving.message(), "\n--- fremend log ---\n", process->Log()));
+  }
+  return process;
+}
+
+absl::Status FremendProcess::AwaitServing() {
+  // The line the daemon logs once it is ready ("fremend listening on HOST:PORT, data in ..."), with
+  // the port it got for port 0.
+  constexpr std::string_view kListening = "fremend listening on ";
+  const auto deadline = Clock::now() + kStartTimeout;
+  for (;;) {
+    const std::string log = Log();
+    if (const size_t at = log.find(kListening); at != std::string::npos) {
+      const size_t start = at + kListening.size();
+      address_ = log.substr(start, log.find(',', start) - start);
+      break;
+    }
+    if (Reap(false)) return absl::FailedPreconditionError(absl::StrCat("fremend exited with code ", exit_code_));
+    if (Clock::now() > deadline) return absl::DeadlineExceededError("fremend did not say where it listens");
+    std::this_thread::sleep_for(kPollInterval);
+  }
+  auto health = grpc::health::v1::Health::NewStub(NewChannel());
+  for (;;) {
+    grpc::health::v1::HealthCheckRequest request;
+    grpc::health::v1::HealthCheckResponse response;
+    const grpc::Status status = health->Check(CallContext({}, std::chrono::seconds(5)).get(), request, &response);
+    if (status.ok() && response.status() == grpc::health::v1::HealthCheckResponse::SERVING) return absl::OkStatus();
+    if (Clock::now() > deadline) {
+      return absl::DeadlineExceededError(absl::StrCat("fremend at ", address_, " never became SERVING: ",
+                                                      status.error_message()));
+    }
+    std::this_thread::sleep_for(kPollInterval);
+  }
+}
+
+FremendProcess::~FremendProcess() {
+  if (running_) Kill();
+}
+
+std::shared_ptr<grpc::Channel> FremendProcess::NewChannel() const {
+  return grpc::CreateChannel(address_, credentials_);
+}
+
+std::optional<int> FremendProcess::Reap(bool block) {
+  if (!running_) return exit_code_;
+  int status = 0;
+  const pid_t reaped = waitpid(pid_, &status, block ? 0 : WNOHANG);
+  if (reaped != pid_) return std::nullopt;
+  running_ = false;
+  exit_code_ = ExitCodeOf(status);
+  return exit_code_;
+}
+
+int FremendProcess::Stop(int signal) {
+  if (!running_) return exit_code_;
+  kill(pid_, signal);
+  const auto deadline = Clock::now() + kStopTimeout;
+  while (Clock::now() < deadline) {
+    if (auto code = Reap(false)) return *code;
+    std::this_thread::sleep_for(kPollInterval);
+  }
+  Kill();
+  return -1;
+}
+
+void FremendProcess::Kill() {
+  if (!running_) return;
+  kill(pid_, SIGKILL);
+  Reap(true);
+}
+
+std::string FremendProcess::Log() const { return ReadFile(log_path_); }
+
+std::unique_ptr<grpc::ClientContext> CallContext(const std::vector<std::pair<std::string, std::string>>& metadata,
+                                                 std::chrono::seconds deadline) {
+  auto context = std::make_unique<grpc::ClientContext>();
+  context->set_deadline(std::chrono::system_clock::now() + deadline);
+  for (const auto& [key, value] : metadata) context->AddMetadata(key, value);
+  return context;
+}
+
+void DaemonTest::TearDown() {
+  if (daemon_ != nullptr) StopDaemon();
+}
+
+void DaemonTest::StartDaemon(const std::vector<std::string>& args,
+                             std::shared_ptr<grpc::ChannelCredentials> credentials) {
+  auto started = FremendProcess::Start(data_dir(), args, std::move(credentials));
+  ASSERT_TRUE(started.ok()) << started.status();
+  daemon_ = *std::move(started);
+}
+
+void DaemonTest::StopDaemon() {
+  ASSERT_NE(daemon_, nullptr);
+  EXPECT_EQ(daemon_->Stop(), 0) << daemon_->Log();
+  daemon_.reset();
+}
+
+}  // namespace fremen::testing

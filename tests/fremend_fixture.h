@@ -1,0 +1,118 @@
+// End-to-end test support: the real fremend binary (FREMEND_BINARY, set by CMake) run as a child
+// process on a free loopback port, with a data directory the test owns, and gRPC channels to it.
+//
+// FremendProcess::Start passes --listen 127.0.0.1:0 (the daemon logs the port it was given),
+// sends the daemon's output to a log file, and returns once the daemon has logged its address and
+// the health service says SERVING. Stop() sends SIGTERM and returns the exit code; Kill() is
+// kill -9. A test restarts a daemon on the same data directory to check what survives. A daemon
+// dies with the test process that started it, even when the test crashes.
+// Thread-compatible: one test thread drives a process.
+#pragma once
+
+#include <grpcpp/grpcpp.h>
+#include <sys/types.h>
+
+#include <chrono>
+#include <csignal>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "gtest/gtest.h"
+
+namespace fremen::testing {
+
+// A fresh directory under the system's temporary directory, removed with everything in it.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::string& path() const { return path_; }
+  // path()/name.
+  std::string Path(const std::string& name) const { return path_ + "/" + name; }
+  // Writes a file; returns its path.
+  std::string Write(const std::string& name, const std::string& text) const;
+
+ private:
+  std::string path_;
+};
+
+struct RunResult {
+  int exit_code = -1;  // -1: did not exit normally
+  std::string output;  // stdout and stderr
+};
+
+// Runs fremend with `args` to completion (help, bad configuration, --check-config).
+RunResult RunFremend(const std::vector<std::string>& args);
+
+class FremendProcess {
+ public:
+  // Starts fremend serving `data_dir`, with `args` added to the command line, and waits until it
+  // is SERVING (talking to it with `credentials`). The error carries the daemon's log.
+  static absl::StatusOr<std::unique_ptr<FremendProcess>> Start(
+      const std::string& data_dir, const std::vector<std::string>& args = {},
+      std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials());
+  // Kills the daemon when a test left it running.
+  ~FremendProcess();
+
+  const std::string& address() const { return address_; }
+  pid_t pid() const { return pid_; }
+  // A new channel to the daemon, with the credentials Start was given.
+  std::shared_ptr<grpc::Channel> NewChannel() const;
+
+  // Sends `signal` (SIGTERM or SIGINT), then waits for the exit (SIGKILL after a minute). The exit
+  // code; -1 when the daemon died of a signal or had to be killed.
+  int Stop(int signal = SIGTERM);
+  // kill -9, and waits.
+  void Kill();
+  // Everything the daemon has written so far.
+  std::string Log() const;
+
+ private:
+  FremendProcess(pid_t pid, std::string log_path, std::shared_ptr<grpc::ChannelCredentials> credentials)
+      : pid_(pid), log_path_(std::move(log_path)), credentials_(std::move(credentials)) {}
+  absl::Status AwaitServing();
+  // The exit code once the process has ended, -1 for a signal; nullopt while it runs.
+  std::optional<int> Reap(bool block);
+
+  pid_t pid_;
+  const std::string log_path_;
+  std::shared_ptr<grpc::ChannelCredentials> credentials_;
+  std::string address_;
+  bool running_ = true;
+  int exit_code_ = -1;
+};
+
+// A client context with a deadline (so that a hung daemon fails the test instead of hanging it)
+// and the given metadata, e.g. {{"authorization", "Bearer t"}, {"x-fremen-map", "lab"}}.
+std::unique_ptr<grpc::ClientContext> CallContext(
+    const std::vector<std::pair<std::string, std::string>>& metadata = {},
+    std::chrono::seconds deadline = std::chrono::seconds(30));
+
+// A test with one daemon on a fresh data directory: started before each test, and stopped after it
+// with SIGTERM, expecting exit code 0.
+class DaemonTest : public ::testing::Test {
+ protected:
+  void SetUp() override { StartDaemon(); }
+  void TearDown() override;
+
+  // (Re)starts the daemon on the test's data directory with `args` added; a fatal failure when it
+  // does not come up.
+  void StartDaemon(const std::vector<std::string>& args = {},
+                   std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials());
+  // Stops the daemon, expecting exit code 0.
+  void StopDaemon();
+
+  std::string data_dir() const { return dir_.Path("data"); }
+
+  TempDir dir_;
+  std::unique_ptr<FremendProcess> daemon_;
+};
+
+}  // namespace fremen::testing
