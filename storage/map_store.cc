@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <future>
 
@@ -188,6 +189,17 @@ absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
   return absl::OkStatus();
 }
 
+void MapStore::OnRoom(std::function<void()> f) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (queued_observations_ >= options_.max_queued_observations && !closing_) {
+      room_waiters_.push_back(std::move(f));
+      return;
+    }
+  }
+  f();
+}
+
 absl::StatusOr<BatchAck> MapStore::Write(ObservationBatch batch) {
   std::promise<absl::StatusOr<BatchAck>> promise;
   auto future = promise.get_future();
@@ -198,13 +210,14 @@ absl::StatusOr<BatchAck> MapStore::Write(ObservationBatch batch) {
   return future.get();
 }
 
-absl::StatusOr<uint64_t> MapStore::RunControl(Control::Kind kind) {
+absl::StatusOr<uint64_t> MapStore::RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress) {
   std::promise<absl::StatusOr<uint64_t>> promise;
   auto future = promise.get_future();
   {
     std::lock_guard lock(queue_mutex_);
     if (!committer_.joinable() || closing_) return absl::UnavailableError(absl::StrCat("map ", info_.name, " is closed"));
-    controls_.push_back({kind, [&](absl::StatusOr<uint64_t> r) { promise.set_value(std::move(r)); }});
+    controls_.push_back(
+        {kind, [&](absl::StatusOr<uint64_t> r) { promise.set_value(std::move(r)); }, std::move(progress)});
   }
   queue_ready_.notify_one();
   return future.get();
@@ -212,7 +225,9 @@ absl::StatusOr<uint64_t> MapStore::RunControl(Control::Kind kind) {
 
 absl::Status MapStore::Checkpoint() { return RunControl(Control::Kind::kCheckpoint).status(); }
 
-absl::StatusOr<uint64_t> MapStore::PublishModels() { return RunControl(Control::Kind::kPublish); }
+absl::StatusOr<uint64_t> MapStore::PublishModels(std::function<void(uint64_t, uint64_t)> progress) {
+  return RunControl(Control::Kind::kPublish, std::move(progress));
+}
 
 absl::Status MapStore::Close() {
   {
@@ -229,6 +244,7 @@ void MapStore::CommitLoop() {
   for (;;) {
     std::vector<Pending> group;
     std::vector<Control> controls;
+    std::vector<std::function<void()>> room;
     bool closing;
     {
       std::unique_lock lock(queue_mutex_);
@@ -239,11 +255,13 @@ void MapStore::CommitLoop() {
         queue_.pop_front();
       }
       controls.swap(controls_);
+      room.swap(room_waiters_);  // the queue was just emptied: there is room
       closing = closing_;
     }
+    for (auto& f : room) f();
     if (!group.empty()) CommitGroup(group);
     for (Control& c : controls) {
-      if (c.kind == Control::Kind::kPublish) c.done(DoPublish());
+      if (c.kind == Control::Kind::kPublish) c.done(DoPublish(c.progress));
     }
     const bool checkpoint_asked = std::any_of(controls.begin(), controls.end(),
                                               [](const Control& c) { return c.kind == Control::Kind::kCheckpoint; });
@@ -318,7 +336,7 @@ void MapStore::IndexLabels(std::span<const StateLabel> labels) {
   }
 }
 
-absl::StatusOr<uint64_t> MapStore::DoPublish() {
+absl::StatusOr<uint64_t> MapStore::DoPublish(const std::function<void(uint64_t, uint64_t)>& progress) {
   {
     std::lock_guard lock(queue_mutex_);
     if (!write_error_.ok()) return write_error_;
@@ -331,10 +349,23 @@ absl::StatusOr<uint64_t> MapStore::DoPublish() {
     return s;
   }
   std::vector<uint64_t> published(shards_.size());
-  workers_->RunOnAll([&](uint32_t s) { published[s] = shards_[s]->PublishAll(); });
+  std::vector<std::atomic<uint64_t>> done(shards_.size());
   uint64_t total = 0;
-  for (uint64_t n : published) total += n;
-  return total;
+  for (const auto& shard : shards_) total += shard->Stats().dynamic_states;
+  std::mutex progress_mutex;  // progress is reported from every shard's thread
+  workers_->RunOnAll([&](uint32_t s) {
+    published[s] = shards_[s]->PublishAll([&](uint64_t shard_done) {
+      done[s] = shard_done;
+      if (!progress) return;
+      uint64_t all = 0;
+      for (const auto& d : done) all += d;
+      std::lock_guard lock(progress_mutex);
+      progress(all, total);
+    });
+  });
+  uint64_t count = 0;
+  for (uint64_t n : published) count += n;
+  return count;
 }
 
 absl::Status MapStore::DoCheckpoint() {
@@ -391,6 +422,12 @@ absl::Status MapStore::PredictBox(const CellBox& box, double t, const PredictOpt
 }
 
 std::optional<StateSnapshot> MapStore::Snapshot(uint64_t key) const { return ShardFor(key).Snapshot(key); }
+
+std::vector<uint8_t> MapStore::Observed(std::span<const uint64_t> keys) const {
+  std::vector<uint8_t> out(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i) out[i] = ShardFor(keys[i]).Observed(keys[i]);
+  return out;
+}
 
 absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStore::TopN(const std::string& group, double t, size_t n,
                                                                       const PredictOptions& options) const {
@@ -454,7 +491,7 @@ MapStats MapStore::Stats() const {
   return stats;
 }
 
-absl::Status MapStore::Backup(const std::string& dir) {
+absl::StatusOr<uint64_t> MapStore::Backup(const std::string& dir) {
   if (absl::Status s = MakeDir(dir); !s.ok()) return s;
   if (absl::Status s = Checkpoint(); !s.ok()) return s;
   // No checkpoint can run while this is held, so every shard's copy is at the same log position.
@@ -466,7 +503,12 @@ absl::Status MapStore::Backup(const std::string& dir) {
   info << EncodeMapInfo(info_);
   info.close();
   if (!info) return absl::InternalError(absl::StrCat("cannot write ", dir, "/map.info"));
-  return absl::OkStatus();
+  uint64_t bytes = 0;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir, error)) {
+    if (entry.is_regular_file(error)) bytes += entry.file_size(error);
+  }
+  return bytes;
 }
 
 }  // namespace fremen::storage

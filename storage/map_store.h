@@ -82,11 +82,16 @@ class MapStore {
   absl::Status Submit(ObservationBatch batch, AckCallback done);
   // Submit and wait.
   absl::StatusOr<BatchAck> Write(ObservationBatch batch);
+  // Runs `f` once (on the committer thread, or at once when there is room now) when the queue has
+  // room again after Submit answered ResourceExhausted: a streaming handler stops reading and
+  // resumes from here, instead of polling.
+  void OnRoom(std::function<void()> f);
   // Checkpoints now and waits.
   absl::Status Checkpoint();
   // Republishes every dynamic state's P with its best order (the update job's core), logged so that
   // recovery repeats it at the same point among the batches. Waits; returns states published.
-  absl::StatusOr<uint64_t> PublishModels();
+  // `progress(done, total)` is called from time to time while the shards publish.
+  absl::StatusOr<uint64_t> PublishModels(std::function<void(uint64_t, uint64_t)> progress = nullptr);
   // Stops accepting writes, finishes the queued ones and checkpoints. Idempotent.
   absl::Status Close();
 
@@ -97,12 +102,16 @@ class MapStore {
   // p(t) of every cell of a box of a grid, x fastest; unobserved cells 0.5.
   absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options, std::vector<float>& out) const;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const;
+  // observed[i]: whether keys[i] was ever observed.
+  std::vector<uint8_t> Observed(std::span<const uint64_t> keys) const;
+  std::optional<std::pair<std::string, std::string>> Label(uint64_t key) const { return ShardFor(key).Label(key); }
   // The n states of `group` most likely to be 1 at t, most likely first.
   absl::StatusOr<std::vector<std::pair<uint64_t, float>>> TopN(const std::string& group, double t, size_t n,
                                                                const PredictOptions& options) const;
   MapStats Stats() const;
   // A consistent copy of every shard and the map's info into `dir` (created, must be empty).
-  absl::Status Backup(const std::string& dir);
+  // Returns the bytes written.
+  absl::StatusOr<uint64_t> Backup(const std::string& dir);
 
  private:
   // A submitted batch. Everything that needs no shared state — classification, the log record,
@@ -120,6 +129,7 @@ class MapStore {
   struct Control {
     enum class Kind { kCheckpoint, kPublish } kind;
     std::function<void(absl::StatusOr<uint64_t>)> done;
+    std::function<void(uint64_t, uint64_t)> progress;
   };
 
   MapStore(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings);
@@ -127,8 +137,8 @@ class MapStore {
   void CommitLoop();
   void CommitGroup(std::vector<Pending>& group);
   absl::Status DoCheckpoint();
-  absl::StatusOr<uint64_t> DoPublish();
-  absl::StatusOr<uint64_t> RunControl(Control::Kind kind);
+  absl::StatusOr<uint64_t> DoPublish(const std::function<void(uint64_t, uint64_t)>& progress);
+  absl::StatusOr<uint64_t> RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress = nullptr);
   // Splits the accepted observations of a batch by shard.
   void SplitByShard(Pending& pending) const;
   // Classifies, encodes and splits a batch.
@@ -151,6 +161,7 @@ class MapStore {
   uint64_t queued_observations_ = 0;
   bool closing_ = false;
   std::vector<Control> controls_;
+  std::vector<std::function<void()>> room_waiters_;
   absl::Status write_error_;  // latched: a failed log sync or checkpoint stops all writes
 
   std::mutex backup_mutex_;  // held by checkpoints and backups: a backup sees one checkpoint

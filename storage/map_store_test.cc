@@ -252,3 +252,58 @@ TEST(MapStoreTest, AFailedLogSyncIsNeverAcknowledgedAndLatches) {
 
 }  // namespace
 }  // namespace fremen::storage
+
+namespace fremen::storage {
+namespace {
+
+TEST(MapStoreTest, RefusesWhenBehindAndCallsBackWhenThereIsRoom) {
+  testing::TempDir dir;
+  const MapInfo map = testing::GridMap("m", 64, 64, 1, 1);
+  StoreOptions options;
+  options.max_queued_observations = 1000;
+  auto store = MapStore::Open(map, dir.path(), options);
+  ASSERT_TRUE(store.ok());
+  std::atomic<int> acked = 0;
+  int refused = 0;
+  std::atomic<bool> room = false;
+  for (uint64_t i = 0; i < 200 && refused == 0; ++i) {
+    const absl::Status s = (*store)->Submit(testing::SweepScan(map, 1, i, 900), [&](auto ack) {
+      EXPECT_TRUE(ack.ok());
+      ++acked;
+    });
+    if (absl::IsResourceExhausted(s)) {
+      ++refused;
+      (*store)->OnRoom([&] { room = true; });
+    }
+  }
+  ASSERT_EQ(refused, 1) << "200 batches of 900 against a queue of 1000 must overflow once";
+  while (!room) std::this_thread::yield();
+  EXPECT_TRUE((*store)->Checkpoint().ok());
+  EXPECT_GT(acked.load(), 0);
+}
+
+TEST(MapStoreTest, ObservedLabelsAndPublicationProgress) {
+  testing::TempDir dir;
+  const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
+  auto store = MapStore::Open(map, dir.path(), {});
+  ASSERT_TRUE(store.ok());
+  for (uint64_t i = 0; i < 100; ++i) ASSERT_TRUE((*store)->Write(testing::SweepScan(map, 1, i, 200)).ok());
+  const ObservationBatch first = testing::SweepScan(map, 1, 0, 200);
+  const uint64_t keys[] = {first.keys[0], map.grid.keys().Key(31, 31, 0) + (uint64_t{1} << 40)};
+  const auto observed = (*store)->Observed(keys);
+  EXPECT_EQ(observed[0], 1);
+  EXPECT_EQ(observed[1], 0);
+  uint64_t last_done = 0, last_total = 0;
+  auto published = (*store)->PublishModels([&](uint64_t done, uint64_t total) {
+    EXPECT_GE(done, last_done);
+    last_done = done;
+    last_total = total;
+  });
+  ASSERT_TRUE(published.ok());
+  EXPECT_EQ(last_done, *published);
+  EXPECT_EQ(last_total, *published);
+  EXPECT_FALSE((*store)->Label(first.keys[0]).has_value());
+}
+
+}  // namespace
+}  // namespace fremen::storage

@@ -196,14 +196,25 @@ void Shard::ApplyLabels(std::span<const StateLabel> labels) {
   }
 }
 
-size_t Shard::PublishAll() {
-  std::unique_lock lock(mutex_);
-  model::PublishAll(spectra_, errors_, settings_.periods, models_);
-  for (uint32_t d = 0; d < slot_of_.size(); ++d) {
-    if (settings_.error_half_life == 0) errors_.Reset(d);  // "only since the last update"
-    MarkDirty(slot_of_[d]);
+size_t Shard::PublishAll(const std::function<void(uint64_t)>& progress) {
+  // In blocks, each under the lock: readers see the old or the new model of a state, never a
+  // torn one, and are not held off for the whole job.
+  constexpr size_t kBlock = 1 << 16;
+  const model::Publisher publisher(settings_.periods, settings_.max_order);
+  const size_t count = slot_of_.size();
+  for (size_t first = 0; first < count; first += kBlock) {
+    const size_t n = std::min(kBlock, count - first);
+    {
+      std::unique_lock lock(mutex_);
+      publisher.PublishRange(spectra_, errors_, first, n, models_);
+      for (size_t d = first; d < first + n; ++d) {
+        if (settings_.error_half_life == 0) errors_.Reset(d);  // "only since the last update"
+        MarkDirty(slot_of_[d]);
+      }
+    }
+    if (progress) progress(first + n);
   }
-  return slot_of_.size();
+  return count;
 }
 
 float Shard::PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f,
@@ -278,6 +289,19 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
       }
     }
   }
+}
+
+bool Shard::Observed(uint64_t key) const {
+  std::shared_lock lock(mutex_);
+  const auto it = bricks_.find(BrickOf(key));
+  return it != bricks_.end() && brick_data_[it->second].handles[key & 511] != kNone;
+}
+
+std::optional<std::pair<std::string, std::string>> Shard::Label(uint64_t key) const {
+  std::shared_lock lock(mutex_);
+  const auto it = labels_.find(key);
+  if (it == labels_.end()) return std::nullopt;
+  return it->second;
 }
 
 std::optional<StateSnapshot> Shard::Snapshot(uint64_t key) const {

@@ -105,7 +105,8 @@ class Shard {
   void ApplyLabels(std::span<const StateLabel> labels);
   // The update of §IV-B for every dynamic state: choose the order with the lowest decayed error and
   // republish P from the spectrum (SPEC §2.4). Returns how many states were published.
-  size_t PublishAll();
+  // `progress(states done)` is called after every block of states.
+  size_t PublishAll(const std::function<void(uint64_t)>& progress = nullptr);
   // Writes every state changed since the last checkpoint, the dedup table and `lsn` in one durable
   // transaction.
   absl::Status Checkpoint(uint64_t lsn, const DedupTable& dedup);
@@ -120,6 +121,10 @@ class Shard {
   void PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
                   float* out) const;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const;
+  // Whether the state was ever observed (cheap: one brick lookup).
+  bool Observed(uint64_t key) const;
+  // A generic state's name and group, when labelled.
+  std::optional<std::pair<std::string, std::string>> Label(uint64_t key) const;
   ShardStats Stats() const;
   // Calls f(key) for every state held (unordered).
   void ForEachKey(const std::function<void(uint64_t)>& f) const;

@@ -95,7 +95,7 @@ absl::Status Store::DeleteMap(const std::string& name) {
   return absl::OkStatus();
 }
 
-absl::Status Store::BackupMap(const std::string& name, const std::string& dir) {
+absl::StatusOr<uint64_t> Store::BackupMap(const std::string& name, const std::string& dir) {
   auto map = Map(name);
   if (!map.ok()) return map.status();
   std::error_code error;

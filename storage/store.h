@@ -31,7 +31,8 @@ class Store {
   absl::StatusOr<std::shared_ptr<MapStore>> Map(const std::string& name) const;
 
   // A consistent copy of a map to `dir`, while it keeps serving.
-  absl::Status BackupMap(const std::string& name, const std::string& dir);
+  // Returns the bytes written.
+  absl::StatusOr<uint64_t> BackupMap(const std::string& name, const std::string& dir);
   // A backup made by BackupMap as a new map named `name` (empty: the backed-up map's name).
   absl::StatusOr<MapInfo> RestoreMap(const std::string& dir, const std::string& name);
 

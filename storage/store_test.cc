@@ -71,11 +71,13 @@ TEST(StoreTest, BackupUnderLoadRestoresAConsistentMap) {
     }
   });
   while (written < 200) std::this_thread::yield();
-  ASSERT_TRUE((*store)->BackupMap("live", backup.path() + "/copy").ok());
+  auto backed_up = (*store)->BackupMap("live", backup.path() + "/copy");
+  ASSERT_TRUE(backed_up.ok());
+  EXPECT_GT(*backed_up, 0u);
   const uint64_t after_backup = written;
   stop = true;
   writer.join();
-  EXPECT_TRUE(absl::IsAlreadyExists((*store)->BackupMap("live", backup.path() + "/copy")));
+  EXPECT_TRUE(absl::IsAlreadyExists((*store)->BackupMap("live", backup.path() + "/copy").status()));
 
   auto restored = (*store)->RestoreMap(backup.path() + "/copy", "restored");
   ASSERT_TRUE(restored.ok()) << restored.status();
