@@ -70,6 +70,7 @@ absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const MapInfo& info, co
   }
   store->workers_ = std::make_unique<ShardWorkers>(info.shards, "fremen-shard");
   store->committer_ = std::thread([s = store.get()] { s->CommitLoop(); });
+  store->applier_ = std::thread([s = store.get()] { s->ApplyLoop(); });
   return store;
 }
 
@@ -116,6 +117,8 @@ absl::Status MapStore::Recover() {
   auto wal = WalWriter::Open(dir_ + "/wal", wal_options);
   if (!wal.ok()) return wal.status();
   wal_ = *std::move(wal);
+  applied_dedup_ = dedup_;
+  applied_lsn_ = wal_->last_lsn();
   for (const auto& shard : shards_) {
     shard->ForEachLabel([&](uint64_t key, const std::string&, const std::string& group) {
       if (!group.empty()) groups_[group].push_back(key);
@@ -236,14 +239,19 @@ absl::Status MapStore::Close() {
   }
   queue_ready_.notify_one();
   if (committer_.joinable()) committer_.join();
+  if (applier_.joinable()) applier_.join();
   std::lock_guard lock(queue_mutex_);
   return write_error_;
 }
 
+void MapStore::Latch(const absl::Status& status) {
+  std::lock_guard lock(queue_mutex_);
+  if (write_error_.ok()) write_error_ = status;
+}
+
 void MapStore::CommitLoop() {
   for (;;) {
-    std::vector<Pending> group;
-    std::vector<Control> controls;
+    Stage stage;
     std::vector<std::function<void()>> room;
     bool closing;
     {
@@ -251,59 +259,103 @@ void MapStore::CommitLoop() {
       queue_ready_.wait(lock, [&] { return !queue_.empty() || closing_ || !controls_.empty(); });
       while (!queue_.empty()) {
         queued_observations_ -= queue_.front().batch.observation_count();
-        group.push_back(std::move(queue_.front()));
+        stage.group.push_back(std::move(queue_.front()));
         queue_.pop_front();
       }
-      controls.swap(controls_);
+      stage.controls.swap(controls_);
       room.swap(room_waiters_);  // the queue was just emptied: there is room
       closing = closing_;
     }
     for (auto& f : room) f();
-    if (!group.empty()) CommitGroup(group);
-    for (Control& c : controls) {
-      if (c.kind == Control::Kind::kPublish) c.done(DoPublish(c.progress));
+    stage.final = closing && stage.group.empty();
+    absl::Status status;
+    {
+      std::lock_guard lock(queue_mutex_);
+      status = write_error_;
     }
-    const bool checkpoint_asked = std::any_of(controls.begin(), controls.end(),
-                                              [](const Control& c) { return c.kind == Control::Kind::kCheckpoint; });
-    if (checkpoint_asked || wal_->bytes() >= options_.checkpoint_log_bytes || (closing && group.empty())) {
-      const absl::Status status = DoCheckpoint();
-      for (Control& c : controls) {
-        if (c.kind == Control::Kind::kCheckpoint) c.done(status.ok() ? absl::StatusOr<uint64_t>(0) : status);
+    // 1. Log the new batches and publications, then sync once for all of them (group commit).
+    if (status.ok()) {
+      std::lock_guard wal(wal_mutex_);
+      LogGroup(stage.group);
+      stage.group_lsn = wal_->last_lsn();
+      for (Control& c : stage.controls) {
+        if (c.kind != Control::Kind::kPublish) continue;
+        const char record[] = {kPublishRecord};
+        c.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(record), 1});
       }
+      status = wal_->Sync();
     }
-    if (closing && group.empty()) return;
+    if (!status.ok()) {
+      // Nothing of this stage is durable: answer it now; checkpoints still run (they only write
+      // what was applied before).
+      Latch(status);
+      for (Pending& p : stage.group) p.done(status);
+      stage.group.clear();
+      std::erase_if(stage.controls, [&](Control& c) {
+        if (c.kind != Control::Kind::kPublish) return false;
+        c.done(status);
+        return true;
+      });
+    }
+    // 2. Hand over to the applier; at most one stage waits, which bounds what is logged but not
+    // yet applied (and so acknowledged late).
+    const bool final = stage.final;
+    {
+      std::unique_lock lock(stage_mutex_);
+      stage_changed_.wait(lock, [&] { return stages_.empty(); });
+      stages_.push_back(std::move(stage));
+    }
+    stage_changed_.notify_all();
+    if (final) return;
   }
 }
 
-void MapStore::CommitGroup(std::vector<Pending>& group) {
-  absl::Status status;
-  {
-    std::lock_guard lock(queue_mutex_);
-    status = write_error_;
-  }
-  // 1. Log the new batches, then sync once for all of them.
-  if (status.ok()) {
-    for (Pending& p : group) {
-      if (dedup_.Seen(p.batch.writer_id, p.batch.sequence)) {
-        p.ack = BatchAck{};
-        p.ack.sequence = p.batch.sequence;
-        p.ack.duplicate = true;
-        continue;
-      }
-      dedup_.Record(p.batch.writer_id, p.batch.sequence);
-      p.ack.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(p.record.data()), p.record.size()});
+void MapStore::LogGroup(std::vector<Pending>& group) {
+  for (Pending& p : group) {
+    if (dedup_.Seen(p.batch.writer_id, p.batch.sequence)) {
+      p.ack = BatchAck{};
+      p.ack.sequence = p.batch.sequence;
+      p.ack.duplicate = true;
+      continue;
     }
-    status = wal_->Sync();
+    dedup_.Record(p.batch.writer_id, p.batch.sequence);
+    p.ack.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(p.record.data()), p.record.size()});
   }
-  if (!status.ok()) {
+}
+
+void MapStore::ApplyLoop() {
+  for (;;) {
+    Stage stage;
     {
-      std::lock_guard lock(queue_mutex_);
-      if (write_error_.ok()) write_error_ = status;
+      std::unique_lock lock(stage_mutex_);
+      stage_changed_.wait(lock, [&] { return !stages_.empty(); });
+      stage = std::move(stages_.front());
+      stages_.pop_front();
     }
-    for (Pending& p : group) p.done(status);
-    return;
+    stage_changed_.notify_all();
+    ApplyGroup(stage.group);
+    applied_lsn_ = std::max(applied_lsn_, stage.group_lsn);
+    bool checkpoint_asked = false;
+    for (Control& c : stage.controls) {
+      if (c.kind == Control::Kind::kPublish) {
+        c.done(DoPublish(c.progress));
+        applied_lsn_ = c.lsn;
+      } else {
+        checkpoint_asked = true;
+      }
+    }
+    if (checkpoint_asked || wal_->bytes() >= options_.checkpoint_log_bytes || stage.final) {
+      const absl::Status status = DoCheckpoint(applied_lsn_);
+      for (Control& c : stage.controls) {
+        if (c.kind == Control::Kind::kCheckpoint) c.done(status.ok() ? absl::StatusOr<uint64_t>(0) : status);
+      }
+    }
+    if (stage.final) return;
   }
-  // 2. Every shard folds in its part of every batch, in batch order.
+}
+
+void MapStore::ApplyGroup(std::vector<Pending>& group) {
+  // Every shard folds in its part of every batch, in batch order.
   std::vector<const Pending*> fresh;
   for (const Pending& p : group) {
     if (!p.ack.duplicate) fresh.push_back(&p);
@@ -311,18 +363,23 @@ void MapStore::CommitGroup(std::vector<Pending>& group) {
   std::vector<ScanContext> scans;
   scans.reserve(fresh.size());
   for (const Pending* p : fresh) scans.emplace_back(settings_->periods, p->batch.time);
-  workers_->RunOnAll([&](uint32_t s) {
-    for (size_t b = 0; b < fresh.size(); ++b) {
-      shards_[s]->Apply(scans[b], fresh[b]->keys[s], fresh[b]->values[s]);
-      std::vector<StateLabel> mine;
-      for (const StateLabel& l : fresh[b]->batch.labels) {
-        if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);
+  if (!fresh.empty()) {
+    workers_->RunOnAll([&](uint32_t s) {
+      for (size_t b = 0; b < fresh.size(); ++b) {
+        shards_[s]->Apply(scans[b], fresh[b]->keys[s], fresh[b]->values[s]);
+        std::vector<StateLabel> mine;
+        for (const StateLabel& l : fresh[b]->batch.labels) {
+          if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);
+        }
+        if (!mine.empty()) shards_[s]->ApplyLabels(mine);
       }
-      if (!mine.empty()) shards_[s]->ApplyLabels(mine);
-    }
-  });
-  for (const Pending* p : fresh) IndexLabels(p->batch.labels);
-  // 3. Durable and visible: acknowledge.
+    });
+  }
+  for (const Pending* p : fresh) {
+    IndexLabels(p->batch.labels);
+    applied_dedup_.Record(p->batch.writer_id, p->batch.sequence);
+  }
+  // Durable and visible: acknowledge.
   for (Pending& p : group) p.done(p.ack);
 }
 
@@ -337,17 +394,7 @@ void MapStore::IndexLabels(std::span<const StateLabel> labels) {
 }
 
 absl::StatusOr<uint64_t> MapStore::DoPublish(const std::function<void(uint64_t, uint64_t)>& progress) {
-  {
-    std::lock_guard lock(queue_mutex_);
-    if (!write_error_.ok()) return write_error_;
-  }
-  const char record[] = {kPublishRecord};
-  wal_->Append({reinterpret_cast<const uint8_t*>(record), 1});
-  if (absl::Status s = wal_->Sync(); !s.ok()) {
-    std::lock_guard lock(queue_mutex_);
-    if (write_error_.ok()) write_error_ = s;
-    return s;
-  }
+  // The committer has logged and synced the publication's record already.
   std::vector<uint64_t> published(shards_.size());
   std::vector<std::atomic<uint64_t>> done(shards_.size());
   uint64_t total = 0;
@@ -368,11 +415,10 @@ absl::StatusOr<uint64_t> MapStore::DoPublish(const std::function<void(uint64_t, 
   return count;
 }
 
-absl::Status MapStore::DoCheckpoint() {
+absl::Status MapStore::DoCheckpoint(uint64_t lsn) {
   std::lock_guard backup(backup_mutex_);
-  const uint64_t lsn = wal_->last_lsn();
   std::vector<absl::Status> results(shards_.size());
-  workers_->RunOnAll([&](uint32_t s) { results[s] = shards_[s]->Checkpoint(lsn, dedup_); });
+  workers_->RunOnAll([&](uint32_t s) { results[s] = shards_[s]->Checkpoint(lsn, applied_dedup_); });
   absl::Status status;
   for (const absl::Status& r : results) {
     if (!r.ok()) {
@@ -380,14 +426,14 @@ absl::Status MapStore::DoCheckpoint() {
       break;
     }
   }
-  if (status.ok()) status = wal_->DropThrough(lsn);
+  if (status.ok()) {
+    std::lock_guard wal(wal_mutex_);
+    status = wal_->DropThrough(lsn);
+  }
   // Reader slots of processes that died while reading (a backup tool, mdb_stat) would pin old
   // pages forever; clearing them with every checkpoint bounds the file's growth.
   for (const auto& shard : shards_) (void)shard->env().ClearStaleReaders();
-  if (!status.ok()) {
-    std::lock_guard lock(queue_mutex_);
-    if (write_error_.ok()) write_error_ = status;
-  }
+  if (!status.ok()) Latch(status);
   return status;
 }
 

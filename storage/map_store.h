@@ -130,13 +130,27 @@ class MapStore {
     enum class Kind { kCheckpoint, kPublish } kind;
     std::function<void(absl::StatusOr<uint64_t>)> done;
     std::function<void(uint64_t, uint64_t)> progress;
+    uint64_t lsn = 0;  // a publication's log record
+  };
+  // What the committer hands the applier: a logged group and the requests after it. The committer
+  // logs and syncs the next group while the applier applies this one, so that the sync's wait
+  // overlaps useful work.
+  struct Stage {
+    std::vector<Pending> group;     // logged; failed batches were answered already
+    std::vector<Control> controls;  // served in order, after the group
+    uint64_t group_lsn = 0;         // the log position once the group is applied
+    bool final = false;             // the map is closing: checkpoint and stop
   };
 
   MapStore(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings);
   absl::Status Recover();
   void CommitLoop();
-  void CommitGroup(std::vector<Pending>& group);
-  absl::Status DoCheckpoint();
+  // Appends the group's new batches to the log (marking retries as duplicates); wal_mutex_ held.
+  void LogGroup(std::vector<Pending>& group);
+  void Latch(const absl::Status& status);
+  void ApplyLoop();
+  void ApplyGroup(std::vector<Pending>& group);
+  absl::Status DoCheckpoint(uint64_t lsn);
   absl::StatusOr<uint64_t> DoPublish(const std::function<void(uint64_t, uint64_t)>& progress);
   absl::StatusOr<uint64_t> RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress = nullptr);
   // Splits the accepted observations of a batch by shard.
@@ -153,7 +167,10 @@ class MapStore {
   std::vector<std::unique_ptr<Shard>> shards_;
   std::unique_ptr<ShardWorkers> workers_;
   std::unique_ptr<WalWriter> wal_;
-  DedupTable dedup_;  // committer only
+  std::mutex wal_mutex_;      // the committer's appends and syncs, the applier's drops
+  DedupTable dedup_;          // committer only: what was logged
+  DedupTable applied_dedup_;  // applier only: what was applied, recorded by checkpoints
+  uint64_t applied_lsn_ = 0;  // applier only
 
   std::mutex queue_mutex_;
   std::condition_variable queue_ready_;
@@ -169,7 +186,12 @@ class MapStore {
   mutable std::mutex groups_mutex_;
   absl::flat_hash_map<std::string, std::vector<uint64_t>> groups_;
 
+  std::mutex stage_mutex_;
+  std::condition_variable stage_changed_;
+  std::deque<Stage> stages_;
+
   std::thread committer_;
+  std::thread applier_;
 };
 
 }  // namespace fremen::storage
