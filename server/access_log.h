@@ -1,6 +1,7 @@
 // The access log: one line per RPC on the "access" logger, written when the call finishes:
 //   CreateMap ipv4:127.0.0.1:40312 OK 1.42ms
 //   GetMap ipv4:127.0.0.1:40312 NOT_FOUND 0.08ms no map named "lab"
+//   Ingest ipv4:127.0.0.1:40318 UNAVAILABLE 8120.55ms batches=812 observations=8120000 rejected=0 fremend is shutting down
 // Thread-safety: a CallRecord belongs to one call; Finish may run on any thread.
 #pragma once
 
@@ -24,8 +25,8 @@ class CallRecord {
   CallRecord(absl::string_view method, const grpc::ServerContextBase& context)
       : method_(method), peer_(context.peer()), start_(absl::Now()) {}
 
-  // Logs the call's line.
-  void Finish(const grpc::Status& status) const;
+  // Logs the call's line; `details` (what a stream carried) follows the duration.
+  void Finish(const grpc::Status& status, absl::string_view details = {}) const;
 
  private:
   absl::string_view method_;  // a literal of the service's method table

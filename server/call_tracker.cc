@@ -1,12 +1,20 @@
 #include "server/call_tracker.h"
 
+#include <vector>
+
 #include "absl/time/clock.h"
 
 namespace fremen::server {
 
+namespace {
+absl::Status ShuttingDown() {
+  return absl::UnavailableError("fremend is shutting down; retry on another daemon or later");
+}
+}  // namespace
+
 absl::Status CallTracker::Begin() {
   std::lock_guard lock(mutex_);
-  if (draining_) return absl::UnavailableError("fremend is shutting down; retry on another daemon or later");
+  if (draining_) return ShuttingDown();
   ++in_flight_;
   return absl::OkStatus();
 }
@@ -16,9 +24,36 @@ void CallTracker::End() {
   if (--in_flight_ == 0 && draining_) idle_.notify_all();
 }
 
+absl::StatusOr<uint64_t> CallTracker::BeginStream(std::weak_ptr<Drainable> call) {
+  std::lock_guard lock(mutex_);
+  if (draining_) return ShuttingDown();
+  ++in_flight_;
+  streams_.emplace(++next_stream_id_, std::move(call));
+  return next_stream_id_;
+}
+
+void CallTracker::EndStream(uint64_t id) {
+  {
+    std::lock_guard lock(mutex_);
+    streams_.erase(id);
+  }
+  End();
+}
+
 int64_t CallTracker::Drain(absl::Duration timeout) {
+  std::vector<std::shared_ptr<Drainable>> streams;
+  {
+    std::lock_guard lock(mutex_);
+    draining_ = true;
+    for (auto& [id, weak] : streams_) {
+      if (auto stream = weak.lock()) streams.push_back(std::move(stream));
+    }
+    streams_.clear();
+  }
+  // Outside the lock: winding down may end the call at once.
+  for (const auto& stream : streams) stream->WindDown();
+  streams.clear();
   std::unique_lock lock(mutex_);
-  draining_ = true;
   idle_.wait_for(lock, absl::ToChronoNanoseconds(timeout), [this] { return in_flight_ == 0; });
   return in_flight_;
 }

@@ -11,8 +11,12 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "server/admin_service.h"
+#include "server/ingest_service.h"
 #include "server/logging.h"
 #include "server/map_service.h"
+#include "server/query_service.h"
+#include "server/update_job.h"
 #include "storage/catalog.h"
 
 namespace fremen::server {
@@ -74,9 +78,11 @@ Daemon::~Daemon() { (void)Stop(); }
 absl::Status Daemon::Start() {
   Log()->info("fremend {} starting", FREMEN_VERSION);
   if (absl::Status s = PrepareDirectories(); !s.ok()) return s;
+  if (absl::Status s = PrepareUpdates(); !s.ok()) return s;
   if (absl::Status s = StartServer(); !s.ok()) return s;
   if (absl::Status s = OpenStore(); !s.ok()) return s;
   SetServing(true);
+  scheduler_->Start();
   auto maps = CountMaps(*store_);
   Log()->info("fremend listening on {}, data in {} ({} maps){}", address_, config_.data_dir,
               maps.ok() ? *maps : 0, auth_.enabled() ? ", tokens required" : "");
@@ -115,6 +121,13 @@ std::shared_ptr<grpc::ServerCredentials> Daemon::Credentials() const {
 void Daemon::AddServices(grpc::ServerBuilder& builder) {
   services_.push_back(std::make_unique<MapServiceImpl>(deps_));
   service_names_.push_back(v1::MapService::service_full_name());
+  services_.push_back(std::make_unique<IngestServiceImpl>(deps_));
+  service_names_.push_back(v1::IngestService::service_full_name());
+  services_.push_back(std::make_unique<QueryServiceImpl>(deps_));
+  service_names_.push_back(v1::QueryService::service_full_name());
+  services_.push_back(std::make_unique<AdminServiceImpl>(
+      deps_, AdminDeps{operations_.get(), scheduler_.get(), &config_, &RealClock::Get()}));
+  service_names_.push_back(v1::AdminService::service_full_name());
   for (const auto& service : services_) builder.RegisterService(service.get());
   service_names_.push_back("");  // the whole server
 }
@@ -159,6 +172,14 @@ absl::Status Daemon::StartServer() {
   return absl::OkStatus();
 }
 
+absl::Status Daemon::PrepareUpdates() {
+  operations_ = std::make_unique<OperationRegistry>(StoreUpdateJob(&store_handle_), RealClock::Get());
+  auto scheduler = NewStoreUpdateScheduler(config_, RealClock::Get(), &store_handle_, operations_.get());
+  if (!scheduler.ok()) return scheduler.status();
+  scheduler_ = *std::move(scheduler);
+  return absl::OkStatus();
+}
+
 absl::Status Daemon::OpenStore() {
   storage::StoreOptions options;
   options.default_shards = config_.shards;
@@ -185,6 +206,7 @@ void Daemon::SetServing(bool serving) {
 absl::Status Daemon::Stop() {
   if (stopped_) return absl::OkStatus();
   stopped_ = true;
+  if (scheduler_ != nullptr) scheduler_->Stop();  // no new scheduled updates while stopping
   if (server_ != nullptr) {
     Log()->info("stopping: NOT_SERVING, no new calls, up to {} for the calls in flight",
                 absl::FormatDuration(config_.shutdown_grace));
@@ -196,6 +218,8 @@ absl::Status Daemon::Stop() {
     server_->Shutdown(std::chrono::system_clock::now());
   }
   blocking_.Stop();
+  // A publication under way finishes (it is short and atomic in the log); queued updates are cancelled.
+  if (operations_ != nullptr) operations_->Stop();
   absl::Status closed;
   if (store_ != nullptr) {
     closed = store_->Close();

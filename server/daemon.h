@@ -2,11 +2,11 @@
 // Stop() takes it down in reverse.
 //
 // Start: data directory (created, locked against a second daemon) → credentials → gRPC server listening, health NOT_SERVING → store opened
-// (recovery: every map's checkpoint, then its log) → health SERVING. Calls that arrive during
+// (recovery: every map's checkpoint, then its log) → health SERVING → update schedule. Calls that arrive during
 // recovery get UNAVAILABLE (server/store_handle.h).
-// Stop: health NOT_SERVING and new calls refused (UNAVAILABLE) → the calls in flight get up to
+// Stop: update schedule stopped → health NOT_SERVING and new calls refused (UNAVAILABLE) → the calls in flight get up to
 // shutdown_grace to finish → gRPC shuts down at once, cancelling what is left → the blocking pool
-// finishes its work → the store finishes queued writes and checkpoints.
+// finishes its work → update jobs end (a publication under way finishes) → the store finishes queued writes and checkpoints.
 //
 // The services served are added in one place, Daemon::AddServices.
 // Thread-safety: Start and Stop from one thread (main); the services run on gRPC's threads.
@@ -24,8 +24,10 @@
 #include "server/call_tracker.h"
 #include "server/config.h"
 #include "server/data_dir_lock.h"
+#include "server/operations.h"
 #include "server/store_handle.h"
 #include "server/unary_call.h"
+#include "server/update_scheduler.h"
 #include "storage/store.h"
 
 namespace fremen::server {
@@ -50,6 +52,8 @@ class Daemon {
   void SetChannelArguments(grpc::ServerBuilder& builder) const;
   absl::Status StartServer();
   absl::Status OpenStore();
+  // The update jobs' registry and schedule, for the admin service.
+  absl::Status PrepareUpdates();
   void SetServing(bool serving);
 
   ServerConfig config_;
@@ -60,6 +64,9 @@ class Daemon {
   ServiceDeps deps_;
   std::unique_ptr<DataDirLock> data_dir_lock_;  // released after the store is closed
   std::unique_ptr<storage::Store> store_;
+  // Update jobs read the store: declared after it, so destroyed before it (Stop stops them first).
+  std::unique_ptr<OperationRegistry> operations_;
+  std::unique_ptr<UpdateScheduler> scheduler_;  // starts operations: destroyed before them
   std::vector<std::unique_ptr<grpc::Service>> services_;
   std::vector<std::string> service_names_;  // for health: each service, and "" for the whole server
   std::unique_ptr<grpc::Server> server_;

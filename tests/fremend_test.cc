@@ -53,8 +53,10 @@ TEST_F(FremendTest, HealthIsServingForTheServerAndEachService) {
   EXPECT_EQ(serving, HealthResponse::SERVING);
   ASSERT_TRUE(Health("fremen.v1.MapService", &serving).ok());
   EXPECT_EQ(serving, HealthResponse::SERVING);
-  // Services not served yet are unknown to health, as to gRPC.
-  EXPECT_EQ(Health("fremen.v1.QueryService", &serving).error_code(), grpc::StatusCode::NOT_FOUND);
+  ASSERT_TRUE(Health("fremen.v1.QueryService", &serving).ok());
+  EXPECT_EQ(serving, HealthResponse::SERVING);
+  // Services the daemon does not serve are unknown to health, as to gRPC.
+  EXPECT_EQ(Health("fremen.v1.NoSuchService", &serving).error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
 TEST_F(FremendTest, ReflectionListsTheServices) {
@@ -63,8 +65,8 @@ TEST_F(FremendTest, ReflectionListsTheServices) {
   const reflection::ServerReflectionResponse response = Reflect(request);
   std::vector<std::string> names;
   for (const auto& service : response.list_services_response().service()) names.push_back(service.name());
-  EXPECT_THAT(names, ::testing::IsSupersetOf({"fremen.v1.MapService", "grpc.health.v1.Health",
-                                              "grpc.reflection.v1alpha.ServerReflection"}));
+  EXPECT_THAT(names, ::testing::IsSupersetOf({"fremen.v1.MapService", "fremen.v1.QueryService",
+                                              "grpc.health.v1.Health", "grpc.reflection.v1alpha.ServerReflection"}));
 }
 
 TEST_F(FremendTest, ReflectionDescribesTheApi) {

@@ -1,0 +1,391 @@
+// fremen_ingest_load: the ingest load generator of issue 4. Against a running fremend it streams
+// scans of grid cells by index (default: 4 streams of 10k-cell scans, at most 8 unacknowledged
+// batches per stream, acknowledged only once durable) and prints the cell observations per second
+// acknowledged (the median of --repetitions windows), the batch rate and the acknowledgement
+// latency. It first prints what one scan costs to encode and decode (the CellIndices layout), and
+// finally the latency of single-state Predict calls when the daemon serves QueryService
+// (client/bench/fremen_query_load is the full query benchmark).
+//
+// The map (default "ingest-load", a 100×100×100 grid = 1M cells) is created when missing. Each
+// run writes as new writers (random ids), so runs against the same map are never duplicates.
+//
+// Uses only the API (fremen_proto + gRPC), as any client does. Threads: a writer and a reader per
+// stream; the main thread samples the counters.
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "CLI/CLI.hpp"
+#include "fremen/v1/ingest.grpc.pb.h"
+#include "fremen/v1/maps.grpc.pb.h"
+#include "fremen/v1/query.grpc.pb.h"
+
+namespace {
+
+namespace v1 = fremen::v1;
+using Clock = std::chrono::steady_clock;
+
+constexpr double kT0 = 1.7e9;
+constexpr double kScanInterval = 0.1;  // seconds between a robot's scans (10 Hz)
+constexpr int kScansPerStream = 16;    // distinct scans each stream cycles through
+
+struct Options {
+  std::string address = "127.0.0.1:50051";
+  std::string map = "ingest-load";
+  std::string token;
+  uint32_t grid = 100;  // cells along each axis of the map, when created
+  int streams = 4;
+  uint32_t cells = 10000;  // per scan
+  int window = 8;          // unacknowledged batches per stream
+  double warmup = 2;       // seconds before the first window
+  double seconds = 5;      // per repetition
+  int repetitions = 5;
+  int predict_calls = 5000;
+};
+
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+// The q-quantile of sorted values.
+double Quantile(const std::vector<double>& sorted, double q) {
+  if (sorted.empty()) return 0;
+  return sorted[std::min(sorted.size() - 1, static_cast<size_t>(q * static_cast<double>(sorted.size())))];
+}
+
+class Client {
+ public:
+  explicit Client(const Options& o)
+      : o_(o),
+        channel_(grpc::CreateChannel(o.address, grpc::InsecureChannelCredentials())),
+        maps_(v1::MapService::NewStub(channel_)),
+        query_(v1::QueryService::NewStub(channel_)) {}
+
+  // A context naming the map (for proxies) and carrying the token.
+  std::unique_ptr<grpc::ClientContext> Context() const {
+    auto context = std::make_unique<grpc::ClientContext>();
+    context->AddMetadata("x-fremen-map", o_.map);
+    if (!o_.token.empty()) context->AddMetadata("authorization", "Bearer " + o_.token);
+    return context;
+  }
+  // A new channel per stream: one HTTP/2 connection each, as separate robots have.
+  std::shared_ptr<grpc::Channel> NewChannel() const {
+    grpc::ChannelArguments args;
+    args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
+    return grpc::CreateCustomChannel(o_.address, grpc::InsecureChannelCredentials(), args);
+  }
+
+  bool EnsureMap() const;
+  void Predict() const;
+
+ private:
+  const Options o_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::MapService::Stub> maps_;
+  std::unique_ptr<v1::QueryService::Stub> query_;
+};
+
+bool Client::EnsureMap() const {
+  v1::GetMapRequest get;
+  get.set_map(o_.map);
+  v1::GetMapResponse got;
+  grpc::Status status = maps_->GetMap(Context().get(), get, &got);
+  if (status.ok()) {
+    const v1::GridSize& size = got.map().grid().size();
+    if (size.x() != o_.grid || size.y() != o_.grid || size.z() != o_.grid) {
+      std::fprintf(stderr, "map %s is %u×%u×%u cells, not --grid %u cubed; choose another --map\n", o_.map.c_str(),
+                   size.x(), size.y(), size.z(), o_.grid);
+      return false;
+    }
+    std::printf("map %s: %u×%u×%u cells, %u shards\n", o_.map.c_str(), size.x(), size.y(), size.z(),
+                got.map().shards());
+    return true;
+  }
+  if (status.error_code() != grpc::StatusCode::NOT_FOUND) {
+    std::fprintf(stderr, "GetMap %s: %s\n", o_.map.c_str(), status.error_message().c_str());
+    return false;
+  }
+  v1::CreateMapRequest create;
+  v1::Map& map = *create.mutable_map();
+  map.set_name(o_.map);
+  map.set_kind(v1::MAP_KIND_GRID);
+  map.mutable_grid()->set_resolution(0.05);
+  map.mutable_grid()->mutable_size()->set_x(o_.grid);
+  map.mutable_grid()->mutable_size()->set_y(o_.grid);
+  map.mutable_grid()->mutable_size()->set_z(o_.grid);
+  v1::CreateMapResponse created;
+  status = maps_->CreateMap(Context().get(), create, &created);
+  if (!status.ok()) {
+    std::fprintf(stderr, "CreateMap %s: %s\n", o_.map.c_str(), status.error_message().c_str());
+    return false;
+  }
+  std::printf("created map %s: %u×%u×%u cells, %u shards\n", o_.map.c_str(), o_.grid, o_.grid, o_.grid,
+              created.map().shards());
+  return true;
+}
+
+// Scan k of a stream: `cells` consecutive cells of the grid (x fastest), starting at a layer of its
+// own, as a robot's sweep covers a neighbourhood; values 0/1.
+v1::IngestRequest MakeScan(const Options& o, int stream, int k, std::mt19937_64& random) {
+  v1::IngestRequest request;
+  request.set_map(o.map);
+  v1::CellIndices& cells = *request.mutable_cells()->mutable_cells();
+  cells.mutable_x()->Reserve(o.cells);
+  cells.mutable_y()->Reserve(o.cells);
+  cells.mutable_z()->Reserve(o.cells);
+  const uint64_t layer = uint64_t{o.grid} * o.grid;
+  const uint64_t first = (static_cast<uint64_t>(stream * kScansPerStream + k) * o.cells) % (layer * o.grid);
+  for (uint64_t i = first; i < first + o.cells; ++i) {
+    const uint64_t c = i % (layer * o.grid);
+    cells.add_x(static_cast<uint32_t>(c % o.grid));
+    cells.add_y(static_cast<uint32_t>(c / o.grid % o.grid));
+    cells.add_z(static_cast<uint32_t>(c / layer));
+    request.mutable_cells()->add_values(random() % 4 == 0 ? 1.0f : 0.0f);
+  }
+  return request;
+}
+
+// What one scan costs on the wire and to encode and decode, one core.
+void MeasureEncoding(const Options& o) {
+  std::mt19937_64 random(1);
+  v1::IngestRequest scan = MakeScan(o, 0, 0, random);
+  scan.set_writer_id(1);
+  scan.set_sequence(12345);
+  scan.set_time(kT0);
+  constexpr int kReps = 200;
+  std::string bytes;
+  auto start = Clock::now();
+  for (int i = 0; i < kReps; ++i) scan.SerializeToString(&bytes);
+  const double encode = Seconds(Clock::now() - start) / kReps;
+  v1::IngestRequest parsed;
+  start = Clock::now();
+  for (int i = 0; i < kReps; ++i) parsed.ParseFromString(bytes);
+  const double decode = Seconds(Clock::now() - start) / kReps;
+  std::printf("one scan of %u cells: %zu bytes (%.1f per cell); encode %.0f µs, decode %.0f µs "
+              "(%.0fM cells/s to decode on one core)\n",
+              o.cells, bytes.size(), static_cast<double>(bytes.size()) / o.cells, encode * 1e6, decode * 1e6,
+              o.cells / decode / 1e6);
+}
+
+// One Ingest stream: a writer keeping up to `window` batches unacknowledged, a reader counting the
+// acknowledgements.
+class LoadStream {
+ public:
+  LoadStream(const Options& o, const Client& client, int index)
+      : o_(o), client_(client), index_(index), writer_id_(std::random_device()() << 16 | index) {}
+
+  void Start() {
+    stub_ = v1::IngestService::NewStub(client_.NewChannel());
+    context_ = client_.Context();
+    stream_ = stub_->Ingest(context_.get());
+    std::mt19937_64 random(index_);
+    for (int k = 0; k < kScansPerStream; ++k) scans_.push_back(MakeScan(o_, index_, k, random));
+    sent_at_.resize(static_cast<size_t>(o_.window) * 2);
+    reader_ = std::thread([this] { Read(); });
+    writer_ = std::thread([this] { Write(); });
+  }
+  // Stops writing, waits for the outstanding acknowledgements; the call's status.
+  grpc::Status Stop() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    room_.notify_all();
+    writer_.join();
+    reader_.join();
+    return stream_->Finish();
+  }
+
+  std::atomic<uint64_t> observations{0};
+  std::atomic<uint64_t> batches{0};
+  std::atomic<bool> failed{false};
+  // Write-to-acknowledgement seconds, under mutex_.
+  std::vector<double> TakeLatencies() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(latencies_, {});
+  }
+
+ private:
+  void Write() {
+    for (uint64_t sequence = 0;; ++sequence) {
+      {
+        std::unique_lock lock(mutex_);
+        room_.wait(lock, [&] { return stopping_ || in_flight_ < o_.window; });
+        if (stopping_) break;
+        ++in_flight_;
+        sent_at_[sequence % sent_at_.size()] = Clock::now();
+      }
+      v1::IngestRequest& scan = scans_[sequence % scans_.size()];
+      scan.set_writer_id(writer_id_);
+      scan.set_sequence(sequence);
+      scan.set_time(kT0 + kScanInterval * static_cast<double>(sequence));
+      if (!stream_->Write(scan)) break;
+    }
+    stream_->WritesDone();
+  }
+
+  void Read() {
+    v1::IngestResponse ack;
+    while (stream_->Read(&ack)) {
+      if (ack.has_error() || ack.rejected() > 0) {
+        if (!failed.exchange(true)) {
+          std::fprintf(stderr, "stream %d: batch %lu: %s (%lu rejected)\n", index_,
+                       static_cast<unsigned long>(ack.sequence()), ack.error().message().c_str(),
+                       static_cast<unsigned long>(ack.rejected()));
+        }
+      }
+      observations += ack.accepted();
+      ++batches;
+      {
+        std::lock_guard lock(mutex_);
+        --in_flight_;
+        latencies_.push_back(Seconds(Clock::now() - sent_at_[ack.sequence() % sent_at_.size()]));
+      }
+      room_.notify_one();
+    }
+  }
+
+  const Options& o_;
+  const Client& client_;
+  const int index_;
+  const uint64_t writer_id_;
+  std::unique_ptr<v1::IngestService::Stub> stub_;
+  std::unique_ptr<grpc::ClientContext> context_;
+  std::unique_ptr<grpc::ClientReaderWriter<v1::IngestRequest, v1::IngestResponse>> stream_;
+  std::vector<v1::IngestRequest> scans_;
+  std::thread reader_, writer_;
+
+  std::mutex mutex_;
+  std::condition_variable room_;
+  int in_flight_ = 0;
+  bool stopping_ = false;
+  std::vector<Clock::time_point> sent_at_;  // by sequence modulo its size (> window)
+  std::vector<double> latencies_;
+};
+
+// Runs the streams and prints the figures; false when a stream failed.
+bool RunIngest(const Options& o, const Client& client) {
+  std::vector<std::unique_ptr<LoadStream>> streams;
+  for (int s = 0; s < o.streams; ++s) streams.push_back(std::make_unique<LoadStream>(o, client, s));
+  for (auto& s : streams) s->Start();
+  const auto total = [&] {
+    uint64_t observations = 0, batches = 0;
+    for (auto& s : streams) {
+      observations += s->observations;
+      batches += s->batches;
+    }
+    return std::pair(observations, batches);
+  };
+  const auto failed = [&] {
+    return std::any_of(streams.begin(), streams.end(), [](const auto& s) { return s->failed.load(); });
+  };
+  std::this_thread::sleep_for(std::chrono::duration<double>(o.warmup));
+  for (auto& s : streams) s->TakeLatencies();
+  std::vector<double> rates, batch_rates, latencies;
+  for (int r = 0; r < o.repetitions && !failed(); ++r) {
+    const auto [obs0, batches0] = total();
+    const auto start = Clock::now();
+    std::this_thread::sleep_for(std::chrono::duration<double>(o.seconds));
+    const auto [obs1, batches1] = total();
+    const double elapsed = Seconds(Clock::now() - start);
+    rates.push_back(static_cast<double>(obs1 - obs0) / elapsed);
+    batch_rates.push_back(static_cast<double>(batches1 - batches0) / elapsed);
+    std::printf("  window %d: %.2fM cell-obs/s, %.0f batches/s\n", r + 1, rates.back() / 1e6, batch_rates.back());
+    std::fflush(stdout);
+  }
+  for (auto& s : streams) {
+    std::vector<double> l = s->TakeLatencies();
+    latencies.insert(latencies.end(), l.begin(), l.end());
+  }
+  bool ok = !failed();
+  for (auto& s : streams) {
+    const grpc::Status status = s->Stop();
+    if (!status.ok()) {
+      std::fprintf(stderr, "stream ended with %d: %s\n", status.error_code(), status.error_message().c_str());
+      ok = false;
+    }
+  }
+  std::sort(latencies.begin(), latencies.end());
+  std::printf("ingest: %d streams × %u-cell scans, ≤ %d unacknowledged each: median %.2fM cell-obs/s "
+              "(%.0f batches/s) over %zu windows of %.0f s; ack latency p50 %.1f ms, p99 %.1f ms\n",
+              o.streams, o.cells, o.window, Median(rates) / 1e6, Median(batch_rates), rates.size(), o.seconds,
+              Quantile(latencies, 0.5) * 1e3, Quantile(latencies, 0.99) * 1e3);
+  return ok;
+}
+
+void Client::Predict() const {
+  if (o_.predict_calls <= 0) return;
+  std::mt19937_64 random(7);
+  std::vector<double> latencies;
+  latencies.reserve(o_.predict_calls);
+  const auto start = Clock::now();
+  for (int i = 0; i < o_.predict_calls; ++i) {
+    v1::PredictRequest request;
+    request.set_map(o_.map);
+    v1::CellIndices& cell = *request.mutable_states()->mutable_cells();
+    cell.add_x(static_cast<uint32_t>(random() % o_.grid));
+    cell.add_y(static_cast<uint32_t>(random() % o_.grid));
+    cell.add_z(0);
+    request.add_times(kT0 + 3600.0 * static_cast<double>(random() % 168));
+    v1::PredictResponse response;
+    const auto call_start = Clock::now();
+    const grpc::Status status = query_->Predict(Context().get(), request, &response);
+    latencies.push_back(Seconds(Clock::now() - call_start));
+    if (status.error_code() == grpc::StatusCode::UNIMPLEMENTED) {
+      std::printf("predict: skipped, the daemon does not serve QueryService yet\n");
+      return;
+    }
+    if (!status.ok()) {
+      std::fprintf(stderr, "Predict: %s\n", status.error_message().c_str());
+      return;
+    }
+  }
+  const double elapsed = Seconds(Clock::now() - start);
+  std::sort(latencies.begin(), latencies.end());
+  std::printf("predict: single state, one call at a time: p50 %.0f µs, p99 %.0f µs, %.0f calls/s\n",
+              Quantile(latencies, 0.5) * 1e6, Quantile(latencies, 0.99) * 1e6, o_.predict_calls / elapsed);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app("fremen_ingest_load: ingest throughput of a running fremend (issue 4 benchmark)");
+  app.add_option("--address", o.address, "fremend's HOST:PORT")->capture_default_str();
+  app.add_option("--map", o.map, "grid map to ingest into (created when missing)")->capture_default_str();
+  app.add_option("--token", o.token, "bearer token with write access, when the daemon wants one");
+  app.add_option("--grid", o.grid, "cells along each axis of a created map")->capture_default_str()->check(CLI::Range(1, 2048));
+  app.add_option("--streams", o.streams, "concurrent Ingest streams")->capture_default_str()->check(CLI::Range(1, 256));
+  app.add_option("--cells", o.cells, "cells per scan")->capture_default_str()->check(CLI::Range(1, 1 << 24));
+  app.add_option("--window", o.window, "unacknowledged batches per stream")->capture_default_str()->check(CLI::Range(1, 1024));
+  app.add_option("--warmup", o.warmup, "seconds before measuring")->capture_default_str();
+  app.add_option("--seconds", o.seconds, "seconds per measured window")->capture_default_str();
+  app.add_option("--repetitions", o.repetitions, "measured windows (the median is reported)")->capture_default_str()->check(CLI::Range(1, 1000));
+  app.add_option("--predict-calls", o.predict_calls, "single-state Predict calls afterwards (0: none)")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  if (uint64_t{o.grid} * o.grid * o.grid < o.cells) {
+    std::fprintf(stderr, "--cells %u exceeds the grid's %u³ cells\n", o.cells, o.grid);
+    return 2;
+  }
+
+  const Client client(o);
+  if (!client.EnsureMap()) return 1;
+  MeasureEncoding(o);
+  const bool ok = RunIngest(o, client);
+  client.Predict();
+  return ok ? 0 : 1;
+}

@@ -1,0 +1,370 @@
+// fremen_query_load: measures QueryService as a C++ client sees it (issue 4's targets) and prints
+// medians:
+//   - PredictRegion of a box (default 1000×1000 = 1M cells) delivered as FLOAT and as UINT8:
+//     seconds per box and cells/s (target ≥ 100M cells/s);
+//   - single-state Predict: latency p50/p99 with one call in flight (targets p50 ≤ 200 µs,
+//     p99 ≤ 1 ms) and the sustained rate, with one and with several calls in flight on one channel,
+//     and the rate of predictions when each call asks for many states (the original FremenServer:
+//     ~80k predictions/s).
+// Against a running fremend. With --create it first creates a grid map and fills it through the
+// IngestService (a dense patch per scan: walls, free space and 1/8 of the cells on a daily rhythm),
+// running the update job through the AdminService after each simulated day, as the nightly job
+// would, so that dynamic cells hold published models whose orders were chosen on evidence.
+// Without those services, prepare a map another way (see client/bench/README.md).
+//
+// Uses only the API (fremen_proto + gRPC), as any client does. Single-threaded except for the
+// --concurrency threads of the Predict rate and the ingest acknowledgement reader.
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fremen/v1/admin.grpc.pb.h"
+#include "fremen/v1/ingest.grpc.pb.h"
+#include "fremen/v1/maps.grpc.pb.h"
+#include "fremen/v1/query.grpc.pb.h"
+
+namespace {
+
+namespace v1 = fremen::v1;
+using Clock = std::chrono::steady_clock;
+
+constexpr double kT0 = 1.7e9;
+
+struct Options {
+  std::string address = "127.0.0.1:50051";
+  std::string map = "bench";
+  std::string token;
+  bool create = false;
+  uint32_t size = 1000;       // grid (when creating) and box: size × size cells
+  uint32_t scans = 56;        // --create: scans of the whole grid
+  double scan_interval = 21600;  // seconds between scans (4 a day: 14 days)
+  int region_reps = 15;
+  int predict_calls = 20000;
+  int concurrency = 8;
+  int batch = 1000;  // states per call of the batched Predict
+};
+
+const char kUsage[] =
+    "usage: fremen_query_load [--address=HOST:PORT] [--map=NAME] [--token=TOKEN] [--create]\n"
+    "                         [--size=CELLS] [--scans=N] [--scan-interval=S] [--region-reps=N]\n"
+    "                         [--predict-calls=N] [--concurrency=N] [--batch=STATES]\n";
+
+Options Parse(int argc, char** argv) {
+  Options o;
+  std::map<std::string, std::string> flags;
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg.rfind("--", 0) != 0) {
+      std::fputs(kUsage, stderr);
+      std::exit(2);
+    }
+    const size_t eq = arg.find('=');
+    flags[arg.substr(2, eq == std::string::npos ? std::string::npos : eq - 2)] =
+        eq == std::string::npos ? "" : arg.substr(eq + 1);
+  }
+  for (const auto& [key, value] : flags) {
+    if (key == "address") o.address = value;
+    else if (key == "map") o.map = value;
+    else if (key == "token") o.token = value;
+    else if (key == "create") o.create = true;
+    else if (key == "size") o.size = static_cast<uint32_t>(std::stoul(value));
+    else if (key == "scans") o.scans = static_cast<uint32_t>(std::stoul(value));
+    else if (key == "scan-interval") o.scan_interval = std::stod(value);
+    else if (key == "region-reps") o.region_reps = std::stoi(value);
+    else if (key == "predict-calls") o.predict_calls = std::stoi(value);
+    else if (key == "concurrency") o.concurrency = std::stoi(value);
+    else if (key == "batch") o.batch = std::stoi(value);
+    else {
+      std::fprintf(stderr, "unknown flag --%s\n%s", key.c_str(), kUsage);
+      std::exit(2);
+    }
+  }
+  return o;
+}
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+double Percentile(std::vector<double>& sorted, double q) {
+  return sorted[std::min(sorted.size() - 1, static_cast<size_t>(q * static_cast<double>(sorted.size())))];
+}
+
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+class Bench {
+ public:
+  explicit Bench(const Options& o)
+      : o_(o),
+        channel_(grpc::CreateCustomChannel(o.address, grpc::InsecureChannelCredentials(), ChannelArgs())),
+        maps_(v1::MapService::NewStub(channel_)),
+        ingest_(v1::IngestService::NewStub(channel_)),
+        admin_(v1::AdminService::NewStub(channel_)),
+        query_(v1::QueryService::NewStub(channel_)) {}
+
+  // A context naming the map (for proxies) and carrying the token.
+  void Prepare(grpc::ClientContext& context) const {
+    context.AddMetadata("x-fremen-map", o_.map);
+    if (!o_.token.empty()) context.AddMetadata("authorization", "Bearer " + o_.token);
+  }
+
+  bool CreateAndFill();
+  void Region(v1::RegionOutput output, const char* name);
+  void Predict();
+
+ private:
+  static grpc::ChannelArguments ChannelArgs() {
+    grpc::ChannelArguments args;
+    args.SetMaxReceiveMessageSize(64 << 20);
+    args.SetMaxSendMessageSize(64 << 20);
+    return args;
+  }
+  // Scans [first, first + count) through one Ingest stream.
+  bool Fill(uint32_t first, uint32_t count);
+  bool Update();
+  // Latencies (seconds) of `calls` Predicts of `states` random cells each, one at a time; `seed`
+  // picks the cells.
+  std::vector<double> PredictLoop(int calls, int states, uint64_t seed, bool* ok);
+
+  const Options o_;
+  // Ours for this run: a rerun does not look like a retry of an earlier run's scans.
+  const uint64_t writer_ = std::random_device()();
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::MapService::Stub> maps_;
+  std::unique_ptr<v1::IngestService::Stub> ingest_;
+  std::unique_ptr<v1::AdminService::Stub> admin_;
+  std::unique_ptr<v1::QueryService::Stub> query_;
+};
+
+bool Bench::CreateAndFill() {
+  grpc::ClientContext context;
+  Prepare(context);
+  v1::CreateMapRequest request;
+  v1::Map& map = *request.mutable_map();
+  map.set_name(o_.map);
+  map.set_kind(v1::MAP_KIND_GRID);
+  map.mutable_grid()->set_resolution(0.05);
+  map.mutable_grid()->mutable_size()->set_x(o_.size);
+  map.mutable_grid()->mutable_size()->set_y(o_.size);
+  v1::CreateMapResponse response;
+  const grpc::Status status = maps_->CreateMap(&context, request, &response);
+  if (!status.ok()) {
+    std::fprintf(stderr, "CreateMap %s: %s\n", o_.map.c_str(), status.error_message().c_str());
+    return false;
+  }
+  const uint32_t per_day = std::max(1u, static_cast<uint32_t>(std::lround(86400 / o_.scan_interval)));
+  const auto start = Clock::now();
+  for (uint32_t first = 0; first < o_.scans; first += per_day) {
+    if (!Fill(first, std::min(per_day, o_.scans - first)) || !Update()) return false;
+  }
+  const double secs = Seconds(Clock::now() - start);
+  const double cells = static_cast<double>(o_.size) * o_.size;
+  std::printf("filled %s: %u scans of %.0f cells, updated daily, in %.2f s (%.1fM cell-obs/s with the updates)\n",
+              o_.map.c_str(), o_.scans, cells, secs, o_.scans * cells / secs / 1e6);
+  return true;
+}
+
+bool Bench::Fill(uint32_t first, uint32_t count) {
+  const uint64_t cells = uint64_t{o_.size} * o_.size;
+  // Two patches: day and night. Walls (every 16th row) always occupied, 1/8 of the columns occupied
+  // by day (doors, people), the rest free.
+  std::string day(cells, '\0'), night(cells, '\0');
+  for (uint64_t i = 0; i < cells; ++i) {
+    const uint64_t x = i % o_.size, y = i / o_.size;
+    if (y % 16 == 0) day[i] = night[i] = static_cast<char>(255);
+    else if (x % 8 == 0) day[i] = static_cast<char>(255);
+  }
+  grpc::ClientContext context;
+  Prepare(context);
+  auto stream = ingest_->Ingest(&context);
+  std::atomic<uint64_t> acked{0}, refused{0};
+  std::thread reader([&] {
+    v1::IngestResponse ack;
+    while (stream->Read(&ack)) {
+      if (ack.error().code() != 0) ++refused;
+      ++acked;
+    }
+  });
+  for (uint32_t s = first; s < first + count; ++s) {
+    v1::IngestRequest batch;
+    batch.set_map(o_.map);
+    batch.set_writer_id(writer_);
+    batch.set_sequence(s + 1);
+    batch.set_time(kT0 + o_.scan_interval * s);
+    const double hour = std::fmod(batch.time(), 86400.0) / 3600.0;
+    v1::DensePatch& patch = *batch.mutable_patch();
+    patch.mutable_size()->set_x(o_.size);
+    patch.mutable_size()->set_y(o_.size);
+    patch.mutable_size()->set_z(1);
+    patch.set_probabilities(hour >= 8 && hour < 20 ? day : night);
+    if (!stream->Write(batch)) break;
+  }
+  stream->WritesDone();
+  reader.join();
+  const grpc::Status status = stream->Finish();
+  if (!status.ok() || acked != count || refused != 0) {
+    std::fprintf(stderr,
+                 "Ingest: %s (%llu of %u scans acknowledged, %llu refused). Without the IngestService, "
+                 "prepare the map as client/bench/README.md says.\n",
+                 status.error_message().c_str(), static_cast<unsigned long long>(acked.load()), count,
+                 static_cast<unsigned long long>(refused.load()));
+    return false;
+  }
+  return true;
+}
+
+bool Bench::Update() {
+  grpc::ClientContext context;
+  Prepare(context);
+  v1::RunUpdateRequest request;
+  request.set_map(o_.map);
+  v1::Operation operation;
+  grpc::Status status = admin_->RunUpdate(&context, request, &operation);
+  while (status.ok() && !operation.done()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    grpc::ClientContext poll;
+    Prepare(poll);
+    v1::GetOperationRequest get;
+    get.set_map(o_.map);
+    get.set_name(operation.name());
+    status = admin_->GetOperation(&poll, get, &operation);
+  }
+  if (!status.ok() || operation.error().code() != 0) {
+    std::fprintf(stderr, "RunUpdate: %s%s (predictions will use γ0 only)\n", status.error_message().c_str(),
+                 operation.error().message().c_str());
+    return false;
+  }
+  return true;
+}
+
+void Bench::Region(v1::RegionOutput output, const char* name) {
+  v1::PredictRegionRequest request;
+  request.set_map(o_.map);
+  request.mutable_hi()->set_x(o_.size);
+  request.mutable_hi()->set_y(o_.size);
+  request.set_time(kT0 + o_.scan_interval * o_.scans + 3600);
+  request.set_output(output);
+  const uint64_t cells = uint64_t{o_.size} * o_.size;
+  std::vector<double> seconds;
+  for (int rep = 0; rep < o_.region_reps; ++rep) {
+    grpc::ClientContext context;
+    Prepare(context);
+    const auto start = Clock::now();
+    auto reader = query_->PredictRegion(&context, request);
+    v1::PredictRegionResponse chunk;
+    uint64_t received = 0, chunks = 0;
+    while (reader->Read(&chunk)) {
+      received += chunk.float_values_size() + chunk.bytes_values().size();
+      ++chunks;
+    }
+    const grpc::Status status = reader->Finish();
+    if (!status.ok() || received != cells) {
+      std::fprintf(stderr, "PredictRegion %s: %s (%llu of %llu cells)\n", name, status.error_message().c_str(),
+                   static_cast<unsigned long long>(received), static_cast<unsigned long long>(cells));
+      return;
+    }
+    seconds.push_back(Seconds(Clock::now() - start));
+    if (rep == 0) std::printf("PredictRegion %-5s %llu cells in %llu chunks\n", name,
+                              static_cast<unsigned long long>(cells), static_cast<unsigned long long>(chunks));
+  }
+  const double median = Median(seconds);
+  std::printf("PredictRegion %-5s median %.2f ms per box = %.1fM cells/s (best %.2f ms)\n", name, median * 1e3,
+              static_cast<double>(cells) / median / 1e6, *std::min_element(seconds.begin(), seconds.end()) * 1e3);
+}
+
+std::vector<double> Bench::PredictLoop(int calls, int states, uint64_t seed, bool* ok) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<uint32_t> cell(0, o_.size - 1);
+  v1::PredictRequest request;
+  request.set_map(o_.map);
+  request.add_times(kT0 + o_.scan_interval * o_.scans + 3600);
+  v1::CellIndices& cells = *request.mutable_states()->mutable_cells();
+  cells.mutable_x()->Resize(states, 0);
+  cells.mutable_y()->Resize(states, 0);
+  std::vector<double> latencies;
+  latencies.reserve(calls);
+  for (int i = 0; i < calls; ++i) {
+    for (int j = 0; j < states; ++j) {
+      cells.set_x(j, cell(rng));
+      cells.set_y(j, cell(rng));
+    }
+    grpc::ClientContext context;
+    Prepare(context);
+    v1::PredictResponse response;
+    const auto start = Clock::now();
+    const grpc::Status status = query_->Predict(&context, request, &response);
+    latencies.push_back(Seconds(Clock::now() - start));
+    if (!status.ok() || response.probabilities_size() != states) {
+      std::fprintf(stderr, "Predict: %s\n", status.error_message().c_str());
+      *ok = false;
+      break;
+    }
+  }
+  return latencies;
+}
+
+void Bench::Predict() {
+  bool ok = true;
+  PredictLoop(std::max(1, o_.predict_calls / 10), 1, 1, &ok);  // warm up the connection and caches
+  if (!ok) return;
+  const auto start = Clock::now();
+  std::vector<double> latencies = PredictLoop(o_.predict_calls, 1, 2, &ok);
+  const double elapsed = Seconds(Clock::now() - start);
+  if (!ok) return;
+  std::sort(latencies.begin(), latencies.end());
+  std::printf("Predict 1 state, 1 in flight:  p50 %.0f µs, p99 %.0f µs, %.0f predictions/s\n",
+              Percentile(latencies, 0.5) * 1e6, Percentile(latencies, 0.99) * 1e6, latencies.size() / elapsed);
+
+  std::vector<std::vector<double>> per_thread(o_.concurrency);
+  std::vector<std::thread> threads;
+  std::atomic<bool> all_ok{true};
+  const int each = std::max(1, o_.predict_calls / o_.concurrency);
+  const auto concurrent_start = Clock::now();
+  for (int t = 0; t < o_.concurrency; ++t) {
+    threads.emplace_back([&, t] {
+      bool thread_ok = true;
+      per_thread[t] = PredictLoop(each, 1, 100 + t, &thread_ok);
+      if (!thread_ok) all_ok = false;
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  const double concurrent_elapsed = Seconds(Clock::now() - concurrent_start);
+  if (!all_ok) return;
+  std::vector<double> all;
+  for (const auto& v : per_thread) all.insert(all.end(), v.begin(), v.end());
+  std::sort(all.begin(), all.end());
+  std::printf("Predict 1 state, %d in flight: p50 %.0f µs, p99 %.0f µs, %.0f predictions/s\n", o_.concurrency,
+              Percentile(all, 0.5) * 1e6, Percentile(all, 0.99) * 1e6, all.size() / concurrent_elapsed);
+
+  const int batch_calls = std::max(1, o_.predict_calls / 20);
+  const auto batch_start = Clock::now();
+  std::vector<double> batches = PredictLoop(batch_calls, o_.batch, 3, &ok);
+  const double batch_elapsed = Seconds(Clock::now() - batch_start);
+  if (!ok) return;
+  std::sort(batches.begin(), batches.end());
+  std::printf("Predict %d states a call, 1 in flight: p50 %.0f µs a call, %.0f predictions/s\n", o_.batch,
+              Percentile(batches, 0.5) * 1e6, static_cast<double>(o_.batch) * batches.size() / batch_elapsed);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options options = Parse(argc, argv);
+  Bench bench(options);
+  if (options.create && !bench.CreateAndFill()) return 1;
+  bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT");
+  bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8");
+  bench.Predict();
+  return 0;
+}

@@ -1,0 +1,273 @@
+#include "server/admin_service.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <system_error>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "server/backup_path.h"
+#include "server/logging.h"
+#include "server/map_convert.h"
+#include "server/map_list.h"
+#include "server/map_name.h"
+#include "server/operation_convert.h"
+#include "storage/catalog.h"
+
+namespace fremen::server {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr MethodSpec kRunUpdate{"RunUpdate", Access::kWrite, /*blocking=*/false};
+constexpr MethodSpec kGetOperation{"GetOperation", Access::kRead, /*blocking=*/false};
+constexpr MethodSpec kListOperations{"ListOperations", Access::kRead, /*blocking=*/false};
+constexpr MethodSpec kCancelOperation{"CancelOperation", Access::kWrite, /*blocking=*/false};
+constexpr MethodSpec kBackupMap{"BackupMap", Access::kWrite, /*blocking=*/true};
+constexpr MethodSpec kRestoreMap{"RestoreMap", Access::kWrite, /*blocking=*/true};
+constexpr MethodSpec kGetServerStatus{"GetServerStatus", Access::kRead, /*blocking=*/true};
+
+constexpr char kOperationPrefix[] = "operations/";
+
+std::shared_ptr<spdlog::logger> Log() {
+  auto logger = spdlog::get(kDaemonLogger);
+  return logger != nullptr ? logger : spdlog::default_logger();
+}
+
+// The map a call names in its field or header, or "" when it names none (where that is allowed:
+// operations are found by name, and a restore may keep the backed-up name).
+absl::StatusOr<std::string> OptionalMapName(const grpc::ServerContextBase& context, const std::string& request_map,
+                                            absl::string_view field) {
+  const auto& metadata = context.client_metadata();
+  const auto header = metadata.find(kMapHeader);
+  if (request_map.empty() && (header == metadata.end() || header->second.empty())) return std::string();
+  return ResolveMapName(context, request_map, field);
+}
+
+// Storage names the map "name"; the restore request calls it "map".
+absl::Status RenameRestoreFields(const absl::Status& status) {
+  if (status.code() != absl::StatusCode::kInvalidArgument || !absl::StartsWith(status.message(), "name")) return status;
+  return absl::InvalidArgumentError(absl::StrCat("map", status.message().substr(4)));
+}
+
+}  // namespace
+
+grpc::ServerUnaryReactor* AdminServiceImpl::RunUpdate(grpc::CallbackServerContext* context,
+                                                      const v1::RunUpdateRequest* request, v1::Operation* response) {
+  return ServeUnary(deps_, context, kRunUpdate, [this, context, request, response]() -> absl::Status {
+    auto name = ResolveMapName(*context, request->map(), "map");
+    if (!name.ok()) return name.status();
+    auto store = deps_.store->Get();
+    if (!store.ok()) return store.status();
+    if (auto info = (*store)->GetMap(*name); !info.ok()) return info.status();
+    auto op = admin_.operations->StartUpdate(*name, "RunUpdate");
+    if (!op.ok()) return op.status();
+    OperationToProto(*op, *response);
+    return absl::OkStatus();
+  });
+}
+
+absl::StatusOr<OperationView> AdminServiceImpl::FindOperation(const grpc::CallbackServerContext& context,
+                                                              const std::string& request_map,
+                                                              const std::string& name) const {
+  if (name.empty()) return absl::InvalidArgumentError("name is required");
+  if (!absl::StartsWith(name, kOperationPrefix)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("name: \"", name, "\" is not an operation name (", kOperationPrefix, "...)"));
+  }
+  auto map = OptionalMapName(context, request_map, "map");
+  if (!map.ok()) return map.status();
+  auto op = admin_.operations->Get(name);
+  if (!op.ok()) return op.status();
+  // A daemon answers only about the map a call was routed for (SPEC §6).
+  if (!map->empty() && op->map != *map) {
+    return absl::NotFoundError(absl::StrCat("no operation named \"", name, "\" on map \"", *map, "\""));
+  }
+  return op;
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::GetOperation(grpc::CallbackServerContext* context,
+                                                         const v1::GetOperationRequest* request,
+                                                         v1::Operation* response) {
+  return ServeUnary(deps_, context, kGetOperation, [this, context, request, response]() -> absl::Status {
+    auto op = FindOperation(*context, request->map(), request->name());
+    if (!op.ok()) return op.status();
+    OperationToProto(*op, *response);
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::ListOperations(grpc::CallbackServerContext* context,
+                                                           const v1::ListOperationsRequest* request,
+                                                           v1::ListOperationsResponse* response) {
+  return ServeUnary(deps_, context, kListOperations, [this, context, request, response]() -> absl::Status {
+    if (request->page_size() < 0) {
+      return absl::InvalidArgumentError(absl::StrCat("page_size must be ≥ 0, got ", request->page_size()));
+    }
+    const size_t page_size = request->page_size() == 0 ? storage::kDefaultPageSize
+                                                       : std::min<size_t>(request->page_size(), storage::kMaxPageSize);
+    auto map = OptionalMapName(*context, request->map(), "map");
+    if (!map.ok()) return map.status();
+    auto page = admin_.operations->List(*map, request->running_only(), page_size, request->page_token());
+    if (!page.ok()) return page.status();
+    for (const OperationView& view : page->operations) OperationToProto(view, *response->add_operations());
+    response->set_next_page_token(page->next_page_token);
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::CancelOperation(grpc::CallbackServerContext* context,
+                                                            const v1::CancelOperationRequest* request,
+                                                            v1::Operation* response) {
+  return ServeUnary(deps_, context, kCancelOperation, [this, context, request, response]() -> absl::Status {
+    auto found = FindOperation(*context, request->map(), request->name());
+    if (!found.ok()) return found.status();
+    auto op = admin_.operations->Cancel(found->name);
+    if (!op.ok()) return op.status();
+    OperationToProto(*op, *response);
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::BackupMap(grpc::CallbackServerContext* context,
+                                                      const v1::BackupMapRequest* request,
+                                                      v1::BackupMapResponse* response) {
+  return ServeUnary(deps_, context, kBackupMap, [this, context, request, response] {
+    return Backup(*request, *context, *response);
+  });
+}
+
+absl::Status AdminServiceImpl::Backup(const v1::BackupMapRequest& request, const grpc::CallbackServerContext& context,
+                                      v1::BackupMapResponse& response) const {
+  auto name = ResolveMapName(context, request.map(), "map");
+  if (!name.ok()) return name.status();
+  auto dir = ResolveBackupPath(admin_.config->backup_dir, request.directory(), "directory");
+  if (!dir.ok()) return dir.status();
+  auto store = deps_.store->Get();
+  if (!store.ok()) return store.status();
+  if (auto info = (*store)->GetMap(*name); !info.ok()) return info.status();
+  if (!ClaimBackupDir(*dir)) {
+    return absl::AlreadyExistsError(
+        absl::StrCat("directory: another backup is being written to \"", request.directory(), "\""));
+  }
+  const absl::Status status = BackupInto(*name, *dir, request.directory(), **store, response);
+  ReleaseBackupDir(*dir);
+  return status;
+}
+
+bool AdminServiceImpl::ClaimBackupDir(const std::string& dir) const {
+  std::lock_guard lock(backups_mutex_);
+  return backups_in_progress_.insert(dir).second;
+}
+
+void AdminServiceImpl::ReleaseBackupDir(const std::string& dir) const {
+  std::lock_guard lock(backups_mutex_);
+  backups_in_progress_.erase(dir);
+}
+
+absl::Status AdminServiceImpl::BackupInto(const std::string& name, const std::string& dir,
+                                          const std::string& requested_dir, storage::Store& store,
+                                          v1::BackupMapResponse& response) const {
+  std::error_code error;
+  const bool existed = fs::exists(dir, error);
+  if (existed && !(fs::is_directory(dir, error) && fs::is_empty(dir, error))) {
+    return absl::AlreadyExistsError(absl::StrCat("directory: \"", requested_dir,
+                                                 "\" already exists in the backup root and is not empty"));
+  }
+  if (fs::create_directories(fs::path(dir).parent_path(), error); error) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("backup_dir: cannot create ", fs::path(dir).parent_path().string(), ": ", error.message()));
+  }
+  const absl::Time start = admin_.clock->Now();
+  auto bytes = store.BackupMap(name, dir);
+  if (!bytes.ok()) {
+    // No half copy left to be mistaken for a backup.
+    fs::remove_all(dir, error);
+    if (existed) fs::create_directory(dir, error);
+    return bytes.status();
+  }
+  const absl::Duration took = admin_.clock->Now() - start;
+  response.set_path(dir);
+  response.set_bytes(*bytes);
+  response.set_duration_seconds(absl::ToDoubleSeconds(took));
+  Log()->info("backup of map {} to {}: {} bytes in {}", name, dir, *bytes, absl::FormatDuration(took));
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::RestoreMap(grpc::CallbackServerContext* context,
+                                                       const v1::RestoreMapRequest* request,
+                                                       v1::RestoreMapResponse* response) {
+  return ServeUnary(deps_, context, kRestoreMap, [this, context, request, response] {
+    return Restore(*request, *context, *response);
+  });
+}
+
+absl::Status AdminServiceImpl::Restore(const v1::RestoreMapRequest& request, const grpc::CallbackServerContext& context,
+                                       v1::RestoreMapResponse& response) const {
+  auto name = OptionalMapName(context, request.map(), "map");
+  if (!name.ok()) return name.status();
+  auto dir = ResolveBackupPath(admin_.config->backup_dir, request.directory(), "directory");
+  if (!dir.ok()) return dir.status();
+  std::error_code error;
+  if (!fs::is_directory(*dir, error)) {
+    return absl::NotFoundError(absl::StrCat("directory: no backup at \"", request.directory(), "\" in the backup root"));
+  }
+  auto store = deps_.store->Get();
+  if (!store.ok()) return store.status();
+  auto info = (*store)->RestoreMap(*dir, *name);
+  if (!info.ok()) return RenameRestoreFields(info.status());
+  MapInfoToProto(*info, *response.mutable_map());
+  Log()->info("map {} restored from {}", info->name, *dir);
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::GetServerStatus(grpc::CallbackServerContext* context,
+                                                            const v1::GetServerStatusRequest* /*request*/,
+                                                            v1::GetServerStatusResponse* response) {
+  return ServeUnary(deps_, context, kGetServerStatus, [this, response] { return FillStatus(*response); });
+}
+
+absl::Status AdminServiceImpl::FillStatus(v1::GetServerStatusResponse& response) const {
+  const ServerConfig& config = *admin_.config;
+  response.set_version(FREMEN_VERSION);
+  TimeToProto(start_time_, *response.mutable_start_time());
+  response.set_uptime_seconds(absl::ToDoubleSeconds(admin_.clock->Now() - start_time_));
+  response.set_running_operations(static_cast<uint32_t>(admin_.operations->running()));
+  if (admin_.scheduler != nullptr) {
+    if (const absl::Time next = admin_.scheduler->NextRun(); next != absl::InfiniteFuture()) {
+      TimeToProto(next, *response.mutable_next_update_time());
+    }
+  }
+  response.set_update_schedule(config.update_schedule);
+  response.set_update_time_zone(config.update_time_zone);
+  response.set_tls(!config.tls_cert_pem.empty());
+  response.set_tokens_required(deps_.auth->enabled());
+  std::error_code error;
+  if (const fs::space_info space = fs::space(config.data_dir, error); !error) {
+    response.set_data_dir_free_bytes(space.available);
+  }
+  for (const OperationView& view : admin_.operations->LastUpdates()) OperationToProto(view, *response.add_last_updates());
+  // While the maps are recovered the status still answers: that is when an operator asks.
+  auto store = deps_.store->Get();
+  if (!store.ok()) {
+    response.set_store_state(v1::STORE_STATE_RECOVERING);
+    return absl::OkStatus();
+  }
+  response.set_store_state(v1::STORE_STATE_OPEN);
+  auto maps = ListAllMaps(**store);
+  if (!maps.ok()) return maps.status();
+  response.set_map_count(maps->size());
+  for (const storage::MapInfo& info : *maps) {
+    auto map = (*store)->Map(info.name);
+    if (!map.ok()) continue;  // deleted meanwhile
+    const storage::MapStats stats = (*map)->Stats();
+    response.set_state_count(response.state_count() + stats.totals.states);
+    response.set_dynamic_state_count(response.dynamic_state_count() + stats.totals.dynamic_states);
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace fremen::server

@@ -1,0 +1,83 @@
+// fremen.v1.AdminService: the update job as a long-running operation (server/operations.h),
+// backups and restores of maps, and the server's status.
+//
+// RunUpdate, GetOperation, ListOperations and CancelOperation only touch the operation registry and
+// the catalog, and run inline; BackupMap and RestoreMap copy files and GetServerStatus reads every
+// map's statistics, so they run on the blocking pool. Write methods (RunUpdate, CancelOperation,
+// BackupMap, RestoreMap) need a write token when tokens are configured.
+// Thread-safety: gRPC calls the handlers from any thread; the registry is thread-safe and the
+// service's one mutable member, the backups in progress, has its own mutex.
+#pragma once
+
+#include <mutex>
+#include <string>
+
+#include "absl/container/flat_hash_set.h"
+#include "absl/time/time.h"
+#include "fremen/v1/admin.grpc.pb.h"
+#include "server/clock.h"
+#include "server/config.h"
+#include "server/operations.h"
+#include "server/unary_call.h"
+#include "server/update_scheduler.h"
+
+namespace fremen::server {
+
+// What the admin service needs beyond ServiceDeps; owned by the daemon, outliving the server.
+struct AdminDeps {
+  OperationRegistry* operations = nullptr;
+  const UpdateScheduler* scheduler = nullptr;  // null: no schedule
+  // The daemon's settings; backup_dir is absolute (resolved before the server starts).
+  const ServerConfig* config = nullptr;
+  const Clock* clock = nullptr;
+};
+
+class AdminServiceImpl final : public v1::AdminService::CallbackService {
+ public:
+  AdminServiceImpl(const ServiceDeps& deps, const AdminDeps& admin)
+      : deps_(deps), admin_(admin), start_time_(admin.clock->Now()) {}
+
+  grpc::ServerUnaryReactor* RunUpdate(grpc::CallbackServerContext* context, const v1::RunUpdateRequest* request,
+                                      v1::Operation* response) override;
+  grpc::ServerUnaryReactor* GetOperation(grpc::CallbackServerContext* context,
+                                         const v1::GetOperationRequest* request, v1::Operation* response) override;
+  grpc::ServerUnaryReactor* ListOperations(grpc::CallbackServerContext* context,
+                                           const v1::ListOperationsRequest* request,
+                                           v1::ListOperationsResponse* response) override;
+  grpc::ServerUnaryReactor* CancelOperation(grpc::CallbackServerContext* context,
+                                            const v1::CancelOperationRequest* request,
+                                            v1::Operation* response) override;
+  grpc::ServerUnaryReactor* BackupMap(grpc::CallbackServerContext* context, const v1::BackupMapRequest* request,
+                                      v1::BackupMapResponse* response) override;
+  grpc::ServerUnaryReactor* RestoreMap(grpc::CallbackServerContext* context, const v1::RestoreMapRequest* request,
+                                       v1::RestoreMapResponse* response) override;
+  grpc::ServerUnaryReactor* GetServerStatus(grpc::CallbackServerContext* context,
+                                            const v1::GetServerStatusRequest* request,
+                                            v1::GetServerStatusResponse* response) override;
+
+ private:
+  // The operation `name` (field "name"), checked against the map the call names, if any.
+  absl::StatusOr<OperationView> FindOperation(const grpc::CallbackServerContext& context,
+                                              const std::string& request_map, const std::string& name) const;
+  absl::Status Backup(const v1::BackupMapRequest& request, const grpc::CallbackServerContext& context,
+                      v1::BackupMapResponse& response) const;
+  // The copy itself, once the directory is claimed.
+  absl::Status BackupInto(const std::string& name, const std::string& dir, const std::string& requested_dir,
+                          storage::Store& store, v1::BackupMapResponse& response) const;
+  absl::Status Restore(const v1::RestoreMapRequest& request, const grpc::CallbackServerContext& context,
+                       v1::RestoreMapResponse& response) const;
+  absl::Status FillStatus(v1::GetServerStatusResponse& response) const;
+
+  // Claims a backup directory for one call (false: another backup is writing there), so that two
+  // concurrent backups never interleave in one directory.
+  bool ClaimBackupDir(const std::string& dir) const;
+  void ReleaseBackupDir(const std::string& dir) const;
+
+  const ServiceDeps deps_;
+  const AdminDeps admin_;
+  const absl::Time start_time_;
+  mutable std::mutex backups_mutex_;
+  mutable absl::flat_hash_set<std::string> backups_in_progress_;
+};
+
+}  // namespace fremen::server

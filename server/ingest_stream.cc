@@ -1,0 +1,264 @@
+#include "server/ingest_stream.h"
+
+#include <grpcpp/alarm.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <thread>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "server/ingest_convert.h"
+#include "server/map_lookup.h"
+#include "server/map_name.h"
+#include "server/status_convert.h"
+
+namespace fremen::server {
+
+namespace {
+
+constexpr MethodSpec kIngest{"Ingest", Access::kWrite, /*blocking=*/false};
+
+// See WaitForRoom: the pause before retrying when the store says there is room but refused the
+// batch anyway, doubled on each repeat.
+constexpr absl::Duration kFirstRetryPause = absl::Milliseconds(1);
+constexpr absl::Duration kLastRetryPause = absl::Milliseconds(50);
+
+// Runs `f` on a gRPC thread after `delay`. The alarm frees itself once it has fired (gRPC keeps
+// the callback alive until it returns).
+void RunAfter(absl::Duration delay, std::function<void()> f) {
+  auto* alarm = new grpc::Alarm;
+  alarm->Set(std::chrono::system_clock::now() + absl::ToChronoNanoseconds(delay),
+             [alarm, f = std::move(f)](bool /*fired*/) {
+               delete alarm;
+               f();
+             });
+}
+
+// Submit's refusals that concern the batch alone; any other ends the stream.
+bool IsBatchError(const absl::Status& status) {
+  return status.code() == absl::StatusCode::kInvalidArgument || status.code() == absl::StatusCode::kOutOfRange;
+}
+
+}  // namespace
+
+IngestStream::IngestStream(const ServiceDeps& deps, grpc::CallbackServerContext* context)
+    : deps_(deps), context_(context), record_(kIngest.name, *context) {}
+
+IngestStream* IngestStream::Start(const ServiceDeps& deps, grpc::CallbackServerContext* context) {
+  std::shared_ptr<IngestStream> stream(new IngestStream(deps, context));
+  stream->self_ = stream;
+  std::lock_guard lock(stream->mutex_);
+  auto id = deps.calls->BeginStream(stream);
+  if (!id.ok()) {
+    stream->EndLocked(id.status());
+  } else {
+    stream->tracker_id_ = *id;
+    if (absl::Status denied = deps.auth->Authorize(*context, kIngest.access, kIngest.name); !denied.ok()) {
+      stream->EndLocked(denied);
+    }
+  }
+  stream->PumpLocked();
+  return stream.get();
+}
+
+void IngestStream::OnReadDone(bool ok) {
+  {
+    std::lock_guard lock(mutex_);
+    reading_ = false;
+    // The client closed its side: answer what is in flight, then end with OK. Or the call failed
+    // (cancelled, a message over the size limit): gRPC has ended it already.
+    if (!ok && context_->IsCancelled()) cancelled_ = true;
+    if (!ok) EndLocked(absl::OkStatus());
+    // A batch read while winding down is dropped unanswered: the client resends it.
+    if (!ok || EndingLocked()) return PumpLocked();
+    // From here until the store has it, request_ is the stream's: no read may overwrite it.
+    holding_ = true;
+  }
+  if (absl::Status routed = Route(); !routed.ok()) {
+    std::lock_guard lock(mutex_);
+    holding_ = false;
+    EndLocked(routed);
+    return PumpLocked();
+  }
+  {
+    std::lock_guard lock(mutex_);
+    held_slot_ = &slots_.emplace_back();
+  }
+  SubmitHeld();
+  std::lock_guard lock(mutex_);
+  PumpLocked();
+}
+
+absl::Status IngestStream::Route() {
+  if (map_ == nullptr) {
+    auto map = LookUpMap(*deps_.store, *context_, request_.map());
+    if (!map.ok()) return map.status();
+    map_ = *std::move(map);
+    map_name_ = map_->info().name;
+    return absl::OkStatus();
+  }
+  auto name = ResolveMapName(*context_, request_.map(), "map");
+  if (!name.ok()) return name.status();
+  if (*name != map_name_) {
+    return absl::InvalidArgumentError(absl::StrCat("map is \"", *name, "\" but this stream ingests into \"", map_name_,
+                                                   "\"; open one stream per map"));
+  }
+  return absl::OkStatus();
+}
+
+void IngestStream::SubmitHeld() {
+  Slot* const slot = held_slot_;
+  auto batch = BatchFromRequest(map_->info(), request_);
+  absl::Status status = batch.status();
+  if (batch.ok()) {
+    status = map_->Submit(*std::move(batch), [self = shared_from_this(), slot](absl::StatusOr<storage::BatchAck> ack) {
+      self->OnAck(*slot, std::move(ack));
+    });
+  }
+  std::unique_lock lock(mutex_);
+  if (status.ok()) {
+    holding_ = false;
+    retry_pause_ = absl::ZeroDuration();
+  } else if (status.code() == absl::StatusCode::kResourceExhausted && !EndingLocked()) {
+    waiting_room_ = true;
+    lock.unlock();
+    WaitForRoom();
+  } else if (IsBatchError(status)) {
+    ErrorToResponse(request_.sequence(), status, slot->response);
+    slot->ready = true;
+    holding_ = false;
+  } else {
+    // The store refuses writes (closing, or a failed log), or the stream is winding down: the batch
+    // stays unanswered, for the client to resend elsewhere or later.
+    slots_.pop_back();
+    holding_ = false;
+    EndLocked(status);
+  }
+}
+
+void IngestStream::WaitForRoom() {
+  // OnRoom calls back at once when it sees room — but it measures room by the queue's fill, while
+  // Submit refuses a batch that would overfill it: with the queue almost full, both hold, and
+  // resubmitting at once would spin. So a call at once, on this thread, waits a short, growing
+  // pause instead; a call from the store's thread comes after it emptied its queue.
+  const std::thread::id caller = std::this_thread::get_id();
+  auto registering = std::make_shared<std::atomic<bool>>(true);
+  map_->OnRoom([self = shared_from_this(), caller, registering] {
+    absl::Duration pause = absl::ZeroDuration();
+    if (registering->load() && std::this_thread::get_id() == caller) {
+      std::lock_guard lock(self->mutex_);
+      self->retry_pause_ = std::clamp(self->retry_pause_ * 2, kFirstRetryPause, kLastRetryPause);
+      pause = self->retry_pause_;
+    }
+    // Off the store's thread either way: converting and preparing a batch is the stream's work.
+    RunAfter(pause, [self] { self->RoomAvailable(); });
+  });
+  registering->store(false);
+}
+
+void IngestStream::RoomAvailable() {
+  {
+    std::lock_guard lock(mutex_);
+    if (!waiting_room_) return;  // dropped by WindDown
+    waiting_room_ = false;
+    if (EndingLocked()) {
+      slots_.pop_back();
+      holding_ = false;
+      return PumpLocked();
+    }
+  }
+  SubmitHeld();
+  std::lock_guard lock(mutex_);
+  PumpLocked();
+}
+
+void IngestStream::OnAck(Slot& slot, absl::StatusOr<storage::BatchAck> ack) {
+  std::lock_guard lock(mutex_);
+  if (ack.ok()) {
+    AckToResponse(*ack, slot.response);
+    slot.ready = true;
+    accepted_ += ack->accepted;
+    rejected_ += ack->rejected;
+  } else {
+    // Not durable, and the store now refuses writes: end the stream once the earlier batches are
+    // answered; the client resends this one and the later ones elsewhere or later.
+    slot.failed = true;
+    slot.failure = ack.status();
+    EndLocked(ack.status());
+  }
+  PumpLocked();
+}
+
+void IngestStream::OnWriteDone(bool ok) {
+  std::lock_guard lock(mutex_);
+  writing_ = false;
+  if (ok) {
+    slots_.pop_front();
+    ++answered_;
+  } else {
+    cancelled_ = true;  // the client is gone
+  }
+  PumpLocked();
+}
+
+void IngestStream::OnCancel() {
+  std::lock_guard lock(mutex_);
+  cancelled_ = true;
+  PumpLocked();
+}
+
+void IngestStream::WindDown() {
+  std::lock_guard lock(mutex_);
+  EndLocked(absl::UnavailableError(
+      "fremend is shutting down; reconnect and resend the batches not acknowledged (repeats are recognised)"));
+  if (waiting_room_) {
+    waiting_room_ = false;
+    holding_ = false;
+    slots_.pop_back();
+  }
+  PumpLocked();
+}
+
+void IngestStream::OnDone() {
+  if (tracker_id_) deps_.calls->EndStream(*tracker_id_);
+  std::shared_ptr<IngestStream> self;
+  {
+    std::lock_guard lock(mutex_);
+    self.swap(self_);
+  }
+  // `self` may be the last owner: the stream is freed here unless the store still holds it.
+}
+
+void IngestStream::EndLocked(absl::Status status) {
+  if (!end_status_) end_status_ = std::move(status);
+}
+
+void IngestStream::PumpLocked() {
+  if (finished_) return;
+  if (!writing_ && !cancelled_ && !slots_.empty() && slots_.front().ready) {
+    writing_ = true;
+    StartWrite(&slots_.front().response);
+  }
+  if (!writing_) {
+    if (cancelled_) return FinishLocked(absl::CancelledError("the client cancelled the stream"));
+    if (!slots_.empty() && slots_.front().failed) return FinishLocked(slots_.front().failure);
+    if (end_status_ && slots_.empty() && !holding_) return FinishLocked(*end_status_);
+  }
+  if (!reading_ && !holding_ && !EndingLocked() && slots_.size() < kMaxUnanswered) {
+    reading_ = true;
+    StartRead(&request_);
+  }
+}
+
+void IngestStream::FinishLocked(const absl::Status& status) {
+  finished_ = true;
+  const grpc::Status converted = ToGrpcStatus(status);
+  record_.Finish(converted,
+                 absl::StrCat("batches=", answered_, " observations=", accepted_, " rejected=", rejected_));
+  Finish(converted);
+}
+
+}  // namespace fremen::server

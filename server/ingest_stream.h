@@ -1,0 +1,119 @@
+// One fremen.v1.IngestService.Ingest call: a bidirectional stream of batches in, one IngestResponse
+// out per batch, in batch order, each once the store says the batch is durable and applied.
+//
+// Flow: OnReadDone converts the request (server/ingest_convert.h) and hands it to
+// MapStore::Submit, whose callback (on a store thread) fills the batch's slot; slots are written
+// in order, one StartWrite at a time.
+// - Backpressure: at most kMaxUnanswered batches are read but not yet answered; beyond that the
+//   stream stops reading (no StartRead) until a response is written, so gRPC flow control slows
+//   the client down. When the store's queue is full (Submit: ResourceExhausted) the request is
+//   held, reading stops, and MapStore::OnRoom resubmits it — no polling, no unbounded buffer.
+// - Errors: a batch unusable as a whole gets a response with `error` and the stream goes on; an
+//   unknown map (NOT_FOUND), another map than the first request's (INVALID_ARGUMENT) or a store
+//   that fails ends the stream once the earlier batches are answered.
+// - Shutdown (CallTracker::Drain → WindDown): reading stops, the batches in the store are answered,
+//   then the stream ends with UNAVAILABLE; a batch read but not submitted is dropped unanswered
+//   (the client resends what was not acknowledged; the store recognises repeats).
+// - Cancellation: the stream finishes at once; batches already submitted still complete in the
+//   store, their acknowledgements are dropped.
+// Lifetime: owned by shared pointers — its own until OnDone, and one in each store callback — so
+// that it outlives both gRPC's last reaction and the store's last callback.
+//
+// Thread-safety: reactions (gRPC threads), store callbacks (store threads) and WindDown (the
+// draining thread) meet under one mutex, under which the gRPC operations are also started (they
+// never run a reaction inline for this reactor); StartRead, StartWrite and Finish are each
+// started at most once at a time, and nothing after Finish.
+#pragma once
+
+#include <grpcpp/server_context.h>
+#include <grpcpp/support/server_callback.h>
+
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "fremen/v1/ingest.pb.h"
+#include "server/access_log.h"
+#include "server/call_tracker.h"
+#include "server/unary_call.h"
+#include "storage/batch.h"
+#include "storage/map_store.h"
+
+namespace fremen::server {
+
+class IngestStream final : public grpc::ServerBidiReactor<v1::IngestRequest, v1::IngestResponse>,
+                           public CallTracker::Drainable,
+                           public std::enable_shared_from_this<IngestStream> {
+ public:
+  // Batches read but not yet answered, per stream: enough to keep a robot's link and the store's
+  // group commit busy, few enough that a stalled stream holds little memory.
+  static constexpr size_t kMaxUnanswered = 8;
+
+  // Starts the call; the reactor frees itself once the call is done and the store is done with it.
+  static IngestStream* Start(const ServiceDeps& deps, grpc::CallbackServerContext* context);
+
+  void OnReadDone(bool ok) override;
+  void OnWriteDone(bool ok) override;
+  void OnCancel() override;
+  void OnDone() override;
+  void WindDown() override;
+
+ private:
+  // One batch's place in the response order.
+  struct Slot {
+    bool ready = false;    // response holds the answer
+    bool failed = false;   // the store failed the batch: the stream ends with `failure`
+    absl::Status failure;
+    v1::IngestResponse response;
+  };
+
+  IngestStream(const ServiceDeps& deps, grpc::CallbackServerContext* context);
+
+  // The map of request_: fixed by the first request, the same for every later one.
+  absl::Status Route();
+  // Converts and submits the held request (its slot: held_slot_). Called without the lock.
+  void SubmitHeld();
+  // After Submit refused the held request for lack of room: resubmit once there is room.
+  void WaitForRoom();
+  // The store has room again (or retry_pause_ has passed): resubmit, unless the stream is ending.
+  void RoomAvailable();
+  void OnAck(Slot& slot, absl::StatusOr<storage::BatchAck> ack);
+  // Ends the stream with `status` once the batches in flight are answered (the first reason wins).
+  void EndLocked(absl::Status status);
+  // Starts what can start now — a write, the finish, a read. REQUIRES: mutex_ held.
+  void PumpLocked();
+  void FinishLocked(const absl::Status& status);
+  bool EndingLocked() const { return end_status_.has_value() || cancelled_ || finished_; }
+
+  const ServiceDeps deps_;
+  grpc::CallbackServerContext* const context_;
+  const CallRecord record_;
+  std::shared_ptr<IngestStream> self_;  // until OnDone
+  std::optional<uint64_t> tracker_id_;  // set once the tracker counts the call
+
+  // Written by the read path only (one read at a time, then the held request), before any
+  // submission that uses them.
+  std::shared_ptr<storage::MapStore> map_;
+  std::string map_name_;
+  v1::IngestRequest request_;  // gRPC's while reading_, the stream's while holding_
+
+  std::mutex mutex_;
+  std::deque<Slot> slots_;  // unanswered batches, in order; references stay valid at both ends
+  Slot* held_slot_ = nullptr;
+  bool reading_ = false;       // a StartRead is outstanding
+  bool holding_ = false;       // request_ holds a batch not yet in the store
+  bool waiting_room_ = false;  // ... because the store's queue is full
+  bool writing_ = false;       // a StartWrite is outstanding (of slots_.front())
+  bool cancelled_ = false;
+  bool finished_ = false;
+  std::optional<absl::Status> end_status_;
+  absl::Duration retry_pause_;  // see WaitForRoom
+  uint64_t answered_ = 0, accepted_ = 0, rejected_ = 0;  // for the access log
+};
+
+}  // namespace fremen::server

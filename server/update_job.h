@@ -1,0 +1,32 @@
+// The update job over the store, and the daemon's update machinery built from it.
+//
+// The job of one map (§IV-B, SPEC §2.4): the map's statistics before, the publication — every
+// dynamic state's order chosen by its decayed prequential error and its P republished, one record
+// of the map's log so that recovery repeats it (storage::MapStore::PublishModels) — and the
+// statistics after, which give the operation's figures (ε_p before/after, order histogram).
+// The schedule: an UpdateScheduler over every map of the store that starts operations.
+// Thread-safety: a job runs on the operation registry's thread; it only reads `store`.
+#pragma once
+
+#include <memory>
+
+#include "absl/status/statusor.h"
+#include "server/clock.h"
+#include "server/config.h"
+#include "server/operations.h"
+#include "server/store_handle.h"
+#include "server/update_scheduler.h"
+
+namespace fremen::server {
+
+// `store` must outlive every job run.
+UpdateJob StoreUpdateJob(const StoreHandle* store);
+
+// The scheduler of the config's update_schedule over every map of `store`, starting updates in
+// `operations` (not started: call Start() once the store is open). Everything must outlive it.
+absl::StatusOr<std::unique_ptr<UpdateScheduler>> NewStoreUpdateScheduler(const ServerConfig& config,
+                                                                         const Clock& clock,
+                                                                         const StoreHandle* store,
+                                                                         OperationRegistry* operations);
+
+}  // namespace fremen::server

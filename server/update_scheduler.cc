@@ -1,0 +1,128 @@
+#include "server/update_scheduler.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "absl/strings/str_cat.h"
+#include "server/logging.h"
+
+namespace fremen::server {
+
+namespace {
+
+std::shared_ptr<spdlog::logger> Log() {
+  auto logger = spdlog::get(kDaemonLogger);
+  return logger != nullptr ? logger : spdlog::default_logger();  // a scheduler inside a unit test
+}
+
+std::string Format(absl::Time t, absl::TimeZone zone) {
+  return t == absl::InfiniteFuture() ? "never" : absl::FormatTime("%Y-%m-%d %H:%M:%S %Z", t, zone);
+}
+
+}  // namespace
+
+UpdateScheduler::UpdateScheduler(Options options, const Clock& clock, MapLister list_maps, Trigger trigger)
+    : options_(std::move(options)), clock_(clock), list_maps_(std::move(list_maps)), trigger_(std::move(trigger)) {
+  const absl::Time now = clock_.Now();
+  if (options_.schedule) entries_.push_back({*options_.schedule, "", options_.schedule->Next(now, options_.zone)});
+  for (const auto& [map, schedule] : options_.overrides) {
+    if (schedule) entries_.push_back({*schedule, map, schedule->Next(now, options_.zone)});
+  }
+}
+
+void UpdateScheduler::Start() {
+  std::lock_guard lock(mutex_);
+  if (entries_.empty() || thread_.joinable() || stopping_) {
+    if (entries_.empty()) Log()->info("no update schedule: updates run only on demand (RunUpdate)");
+    return;
+  }
+  Log()->info("update schedule \"{}\" in {}{}; next run {}", options_.schedule ? options_.schedule->text() : "",
+              options_.zone.name(),
+              options_.overrides.empty() ? "" : absl::StrCat(", ", options_.overrides.size(), " maps with their own"),
+              Format(NextRunLocked(), options_.zone));
+  thread_ = std::thread([this] { Run(); });
+}
+
+void UpdateScheduler::Stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    wake_.notify_all();
+  }
+  if (thread_.joinable()) thread_.join();
+}
+
+absl::Time UpdateScheduler::NextRun() const {
+  std::lock_guard lock(mutex_);
+  return NextRunLocked();
+}
+
+absl::Time UpdateScheduler::NextRunLocked() const {
+  absl::Time next = absl::InfiniteFuture();
+  for (const Entry& e : entries_) next = std::min(next, e.next);
+  return next;
+}
+
+void UpdateScheduler::Run() {
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    const absl::Time now = clock_.Now();
+    std::vector<bool> due(entries_.size(), false);
+    bool any = false;
+    for (size_t i = 0; i < entries_.size(); ++i) {
+      if (entries_[i].next > now) continue;
+      due[i] = any = true;
+      // From now, not from the run that was due: a jump over several runs gives one.
+      entries_[i].next = entries_[i].schedule.Next(now, options_.zone);
+    }
+    if (any) {
+      lock.unlock();
+      Fire(due);
+      lock.lock();
+      Log()->info("next scheduled update {}", Format(NextRunLocked(), options_.zone));
+      continue;
+    }
+    clock_.WaitUntil(wake_, lock, NextRunLocked());
+  }
+}
+
+void UpdateScheduler::Fire(const std::vector<bool>& due) {
+  auto maps = list_maps_();
+  if (!maps.ok()) {
+    Log()->warn("scheduled update skipped: cannot list the maps: {}", std::string(maps.status().message()));
+    return;
+  }
+  const bool default_due = options_.schedule && due[0];
+  size_t started = 0;
+  for (const std::string& map : *maps) {
+    bool run = default_due;
+    if (auto o = options_.overrides.find(map); o != options_.overrides.end()) {
+      run = false;
+      for (size_t i = 0; i < entries_.size(); ++i) run = run || (due[i] && entries_[i].map == map);
+    }
+    if (!run) continue;
+    trigger_(map);
+    ++started;
+  }
+  Log()->info("scheduled update: started for {} of {} maps", started, maps->size());
+}
+
+absl::StatusOr<UpdateScheduler::Options> SchedulerOptionsFromConfig(const ServerConfig& config) {
+  UpdateScheduler::Options options;
+  if (!config.update_schedule.empty()) {
+    auto schedule = CronSchedule::Parse(config.update_schedule);
+    if (!schedule.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat("update_schedule: ", schedule.status().message()));
+    }
+    options.schedule = *std::move(schedule);
+  }
+  if (config.update_time_zone == "local") {
+    options.zone = absl::LocalTimeZone();
+  } else if (!absl::LoadTimeZone(config.update_time_zone, &options.zone)) {
+    return absl::InvalidArgumentError(absl::StrCat("update_time_zone: unknown time zone \"", config.update_time_zone, "\""));
+  }
+  return options;
+}
+
+}  // namespace fremen::server

@@ -1,0 +1,90 @@
+// The update schedule: at each time of a cron schedule (server/cron.h) in a time zone — config
+// update_schedule and update_time_zone, default daily at 00:00 local time — the update job of every
+// map is started (as an operation, server/operations.h, so a map whose update still runs is not
+// updated twice). A map may have its own schedule, or none, instead of the default (Options::
+// overrides).
+//
+// Times are wall-clock times in the zone: a run whose minute a daylight-saving jump skips happens
+// at the instant the jump lands on (02:30 on a spring-forward night in Europe/Prague runs at 03:00
+// CEST); a minute that a fall-back repeats runs once, the first time. A clock that jumps over
+// several runs (a suspended machine, NTP) gives one run, not one per time missed, and runs missed
+// while the daemon was down are not made up (as cron). The thread waits through a Clock
+// (server/clock.h), so tests drive it with a fake clock and no sleeps.
+// Thread-safety: Start and Stop from one thread; NextRun from any thread; the trigger is called on
+// the scheduler's thread and must not block for long.
+#pragma once
+
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "server/clock.h"
+#include "server/config.h"
+#include "server/cron.h"
+
+namespace fremen::server {
+
+class UpdateScheduler {
+ public:
+  struct Options {
+    // The schedule of every map without an override; nullopt = none.
+    std::optional<CronSchedule> schedule;
+    absl::TimeZone zone = absl::UTCTimeZone();
+    // Per map: its own schedule, or nullopt for no scheduled update (on demand only).
+    absl::flat_hash_map<std::string, std::optional<CronSchedule>> overrides;
+  };
+  // The maps to update now; an error skips the run (and is logged).
+  using MapLister = std::function<absl::StatusOr<std::vector<std::string>>()>;
+  using Trigger = std::function<void(const std::string& map)>;
+
+  // `clock` must outlive the scheduler. The next runs are computed from clock.Now() here.
+  UpdateScheduler(Options options, const Clock& clock, MapLister list_maps, Trigger trigger);
+  ~UpdateScheduler() { Stop(); }
+  UpdateScheduler(const UpdateScheduler&) = delete;
+  UpdateScheduler& operator=(const UpdateScheduler&) = delete;
+
+  // Starts the thread; nothing runs before. A scheduler with no schedule at all starts none.
+  void Start();
+  // Stops and joins the thread. Idempotent.
+  void Stop();
+
+  // The next time any map's update is due; InfiniteFuture when none is scheduled.
+  absl::Time NextRun() const;
+
+ private:
+  // One schedule and its next run: the default one (map empty) or a map's override.
+  struct Entry {
+    CronSchedule schedule;
+    std::string map;
+    absl::Time next;
+  };
+
+  void Run();
+  // Starts the updates of the entries that are due; called without the lock.
+  void Fire(const std::vector<bool>& due);
+  absl::Time NextRunLocked() const;
+
+  const Options options_;
+  const Clock& clock_;
+  const MapLister list_maps_;
+  const Trigger trigger_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::vector<Entry> entries_;
+  bool stopping_ = false;
+  std::thread thread_;
+};
+
+// The default schedule from the config (update_schedule, update_time_zone). The config has no
+// per-map overrides yet. InvalidArgument naming the setting (FinishConfig has checked both already).
+absl::StatusOr<UpdateScheduler::Options> SchedulerOptionsFromConfig(const ServerConfig& config);
+
+}  // namespace fremen::server
