@@ -2,7 +2,8 @@
 // as an operation (two triggers make one job, progress reaches the total, cancellation of a
 // queued job, kill -9 mid-job); bad inputs with their exact codes; token roles; backup and
 // restore under a new name; and order selection on generated states of known true order
-// (issue 5): the job picks order 0, 1, 2 and 3 for states made of that many daily harmonics.
+// (issue 5): the job picks order 0, 1, 2 and 3 for states made of that many daily harmonics, as
+// QueryService.GetStateModel then shows.
 //
 // Observations are written with storage::Store in the test process while the daemon is stopped
 // (tests/store_writer.h), so the test does not depend on the ingest service.
@@ -16,6 +17,7 @@
 
 #include "fremen/v1/admin.grpc.pb.h"
 #include "fremen/v1/maps.grpc.pb.h"
+#include "fremen/v1/query.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "tests/fremend_fixture.h"
 #include "tests/store_writer.h"
@@ -516,11 +518,11 @@ TEST_F(AdminServiceTokenTest, ReadTokenReadsButMayNotWrite) {
 // A state of true order `order`: a mean plus the first `order` of the daily, 12-hour and 8-hour
 // harmonics (all in the default Ω of 24 harmonics of a week), with phases of its own.
 struct TrueSignal {
+  static constexpr double kPeriods[3] = {kDay, kDay / 2, kDay / 3};
+  static constexpr double kAmplitudes[3] = {0.25, 0.15, 0.08};
   int order = 0;
   double phase[3] = {0, 0, 0};
   double operator()(double t) const {
-    static constexpr double kPeriods[3] = {kDay, kDay / 2, kDay / 3};
-    static constexpr double kAmplitudes[3] = {0.25, 0.15, 0.08};
     double p = order == 0 ? 0.3 : 0.5;
     for (int j = 0; j < order; ++j) p += kAmplitudes[j] * std::cos(2 * M_PI * t / kPeriods[j] + phase[j]);
     return p;
@@ -569,14 +571,22 @@ TEST_F(AdminServiceTest, UpdatesChooseTheTrueOrderOfGeneratedStates) {
   const v1::Operation second = Update("orders");
   ASSERT_EQ(second.error().code(), 0) << second.error().message();
   EXPECT_LT(second.update().prediction_error_after(), second.update().prediction_error_before());
-  StopDaemon();
-  auto orders = SelectedOrders(data_dir(), "orders", ids);
-  ASSERT_TRUE(orders.ok()) << orders.status();
-  for (size_t i = 0; i < ids.size(); ++i) {
-    EXPECT_EQ((*orders)[i], signals[i].order) << "state " << ids[i] << " of true order " << signals[i].order;
-  }
   EXPECT_THAT(second.update().order_histogram(), ElementsAre(kPerOrder, kPerOrder, kPerOrder, kPerOrder, 0, 0));
-  Start();  // for TearDown
+  // Each state's model, as clients see it: its true order, made of the true harmonics, strongest first.
+  auto query = v1::QueryService::NewStub(daemon_->NewChannel());
+  for (size_t i = 0; i < ids.size(); ++i) {
+    v1::GetStateModelRequest request;
+    request.set_map("orders");
+    request.mutable_state()->set_id(ids[i]);
+    v1::GetStateModelResponse response;
+    const grpc::Status status = query->GetStateModel(CallContext().get(), request, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    const v1::StateModel& model = response.model();
+    EXPECT_EQ(model.selected_order(), signals[i].order) << "state " << ids[i];
+    for (int j = 0; j < signals[i].order && j < model.published_size(); ++j) {
+      EXPECT_NEAR(model.published(j).period_seconds(), TrueSignal::kPeriods[j], 1e-6) << "state " << ids[i];
+    }
+  }
 }
 
 }  // namespace

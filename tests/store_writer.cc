@@ -9,17 +9,9 @@
 
 namespace fremen::testing {
 
-namespace {
-
-absl::StatusOr<std::unique_ptr<storage::Store>> OpenStore(const std::string& data_dir) {
-  return storage::Store::Open(data_dir, storage::StoreOptions());
-}
-
-}  // namespace
-
 absl::Status WriteBatches(const std::string& data_dir, const std::string& map,
                           std::vector<storage::ObservationBatch> batches) {
-  auto store = OpenStore(data_dir);
+  auto store = storage::Store::Open(data_dir, storage::StoreOptions());
   if (!store.ok()) return store.status();
   auto opened = (*store)->Map(map);
   if (!opened.ok()) return opened.status();
@@ -77,23 +69,6 @@ storage::ObservationBatch GridScan(uint32_t nx, uint32_t ny, double t, float val
   batch.patch.size = {nx, ny, 1};
   batch.patch.values.assign(size_t{nx} * ny, value);
   return batch;
-}
-
-absl::StatusOr<std::vector<int>> SelectedOrders(const std::string& data_dir, const std::string& map,
-                                                const std::vector<uint64_t>& ids) {
-  auto store = OpenStore(data_dir);
-  if (!store.ok()) return store.status();
-  auto opened = (*store)->Map(map);
-  if (!opened.ok()) return opened.status();
-  std::vector<int> orders;
-  for (uint64_t id : ids) {
-    const auto snapshot = (*opened)->Snapshot(id);
-    orders.push_back(snapshot && snapshot->model && snapshot->model->has_published()
-                         ? snapshot->model->published().order()
-                         : -1);
-  }
-  if (absl::Status closed = (*store)->Close(); !closed.ok()) return closed;
-  return orders;
 }
 
 }  // namespace fremen::testing

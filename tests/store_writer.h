@@ -1,6 +1,5 @@
-// Test support: data written into a stopped daemon's data directory with storage::Store itself,
-// and per-state results read back the same way — for end-to-end tests that need observations or
-// a state's model without depending on the ingest or query services.
+// Test support: observations written into a stopped daemon's data directory with storage::Store
+// itself, for end-to-end tests that need data without depending on the ingest service.
 // REQUIRES: no daemon runs on the data directory meanwhile. Functions; thread-compatible.
 #pragma once
 
@@ -22,9 +21,5 @@ absl::Status WriteBatches(const std::string& data_dir, const std::string& map,
 storage::ObservationBatch GenericScan(const std::vector<uint64_t>& ids, const std::vector<float>& values, double t);
 // A scan of a whole nx × ny grid, every cell `value`, at time t.
 storage::ObservationBatch GridScan(uint32_t nx, uint32_t ny, double t, float value);
-
-// The selected order of each state's published model; -1 for a state without one.
-absl::StatusOr<std::vector<int>> SelectedOrders(const std::string& data_dir, const std::string& map,
-                                                const std::vector<uint64_t>& ids);
 
 }  // namespace fremen::testing
