@@ -2,11 +2,8 @@
 
 #include <grpcpp/alarm.h>
 
-#include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <functional>
-#include <thread>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -20,11 +17,6 @@ namespace fremen::server {
 namespace {
 
 constexpr MethodSpec kIngest{"Ingest", Access::kWrite, /*blocking=*/false};
-
-// See WaitForRoom: the pause before retrying when the store says there is room but refused the
-// batch anyway, doubled on each repeat.
-constexpr absl::Duration kFirstRetryPause = absl::Milliseconds(1);
-constexpr absl::Duration kLastRetryPause = absl::Milliseconds(50);
 
 // Runs `f` on a gRPC thread after `delay`. The alarm frees itself once it has fired (gRPC keeps
 // the callback alive until it returns).
@@ -113,6 +105,7 @@ void IngestStream::SubmitHeld() {
   Slot* const slot = held_slot_;
   auto batch = BatchFromRequest(map_->info(), request_);
   absl::Status status = batch.status();
+  const uint64_t observations = batch.ok() ? batch->observation_count() : 0;
   if (batch.ok()) {
     status = map_->Submit(*std::move(batch), [self = shared_from_this(), slot](absl::StatusOr<storage::BatchAck> ack) {
       self->OnAck(*slot, std::move(ack));
@@ -121,11 +114,10 @@ void IngestStream::SubmitHeld() {
   std::unique_lock lock(mutex_);
   if (status.ok()) {
     holding_ = false;
-    retry_pause_ = absl::ZeroDuration();
   } else if (status.code() == absl::StatusCode::kResourceExhausted && !EndingLocked()) {
     waiting_room_ = true;
     lock.unlock();
-    WaitForRoom();
+    WaitForRoom(observations);
   } else if (IsBatchError(status)) {
     ErrorToResponse(request_.sequence(), status, slot->response);
     slot->ready = true;
@@ -139,24 +131,14 @@ void IngestStream::SubmitHeld() {
   }
 }
 
-void IngestStream::WaitForRoom() {
-  // OnRoom calls back at once when it sees room — but it measures room by the queue's fill, while
-  // Submit refuses a batch that would overfill it: with the queue almost full, both hold, and
-  // resubmitting at once would spin. So a call at once, on this thread, waits a short, growing
-  // pause instead; a call from the store's thread comes after it emptied its queue.
-  const std::thread::id caller = std::this_thread::get_id();
-  auto registering = std::make_shared<std::atomic<bool>>(true);
-  map_->OnRoom([self = shared_from_this(), caller, registering] {
-    absl::Duration pause = absl::ZeroDuration();
-    if (registering->load() && std::this_thread::get_id() == caller) {
-      std::lock_guard lock(self->mutex_);
-      self->retry_pause_ = std::clamp(self->retry_pause_ * 2, kFirstRetryPause, kLastRetryPause);
-      pause = self->retry_pause_;
-    }
-    // Off the store's thread either way: converting and preparing a batch is the stream's work.
-    RunAfter(pause, [self] { self->RoomAvailable(); });
+void IngestStream::WaitForRoom(uint64_t observations) {
+  // OnRoom applies Submit's own rule, so it calls back when this batch fits (at once if the queue
+  // drained meanwhile). Another stream may still take the room first; then Submit refuses again
+  // and this waits again — on the store's next group, never by polling.
+  map_->OnRoom(observations, [self = shared_from_this()] {
+    // Off the store's thread: converting and preparing a batch is the stream's work.
+    RunAfter(absl::ZeroDuration(), [self] { self->RoomAvailable(); });
   });
-  registering->store(false);
 }
 
 void IngestStream::RoomAvailable() {

@@ -79,8 +79,8 @@ class IngestStream final : public grpc::ServerBidiReactor<v1::IngestRequest, v1:
   // Converts and submits the held request (its slot: held_slot_). Called without the lock.
   void SubmitHeld();
   // After Submit refused the held request for lack of room: resubmit once there is room.
-  void WaitForRoom();
-  // The store has room again (or retry_pause_ has passed): resubmit, unless the stream is ending.
+  void WaitForRoom(uint64_t observations);
+  // The store has room again: resubmit, unless the stream is ending.
   void RoomAvailable();
   void OnAck(Slot& slot, absl::StatusOr<storage::BatchAck> ack);
   // Ends the stream with `status` once the batches in flight are answered (the first reason wins).
@@ -112,7 +112,6 @@ class IngestStream final : public grpc::ServerBidiReactor<v1::IngestRequest, v1:
   bool cancelled_ = false;
   bool finished_ = false;
   std::optional<absl::Status> end_status_;
-  absl::Duration retry_pause_;  // see WaitForRoom
   uint64_t answered_ = 0, accepted_ = 0, rejected_ = 0;  // for the access log
 };
 

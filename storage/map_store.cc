@@ -174,17 +174,26 @@ absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
     return absl::InvalidArgumentError(absl::StrCat("time must not be before the map's lossless origin ",
                                                    info_.lossless_origin, ", got ", batch.time));
   }
-  Pending pending = Prepare(std::move(batch), std::move(done));
-  const uint64_t n = pending.batch.observation_count();
-  {
-    std::lock_guard lock(queue_mutex_);
+  const uint64_t n = batch.observation_count();
+  const auto refusal = [&]() -> absl::Status {
     if (closing_) return absl::UnavailableError(absl::StrCat("map ", info_.name, " is closing"));
     if (!write_error_.ok()) return write_error_;
-    // One batch is always let in, however big, so that a single huge scan is not refused forever.
-    if (queued_observations_ > 0 && queued_observations_ + n > options_.max_queued_observations) {
+    if (!FitsLocked(n)) {
       return absl::ResourceExhaustedError(absl::StrCat("map ", info_.name,
                                                        " is behind on ingest: too many queued observations; retry"));
     }
+    return absl::OkStatus();
+  };
+  {
+    // Checked before the batch is prepared, so that a refusal costs nothing; again after, since
+    // the queue may have filled meanwhile.
+    std::lock_guard lock(queue_mutex_);
+    if (absl::Status refused = refusal(); !refused.ok()) return refused;
+  }
+  Pending pending = Prepare(std::move(batch), std::move(done));
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (absl::Status refused = refusal(); !refused.ok()) return refused;
     queued_observations_ += n;
     queue_.push_back(std::move(pending));
   }
@@ -192,10 +201,10 @@ absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
   return absl::OkStatus();
 }
 
-void MapStore::OnRoom(std::function<void()> f) {
+void MapStore::OnRoom(uint64_t observations, std::function<void()> f) {
   {
     std::lock_guard lock(queue_mutex_);
-    if (queued_observations_ >= options_.max_queued_observations && !closing_) {
+    if (!FitsLocked(observations) && !closing_) {
       room_waiters_.push_back(std::move(f));
       return;
     }

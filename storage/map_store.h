@@ -82,10 +82,10 @@ class MapStore {
   absl::Status Submit(ObservationBatch batch, AckCallback done);
   // Submit and wait.
   absl::StatusOr<BatchAck> Write(ObservationBatch batch);
-  // Runs `f` once (on the committer thread, or at once when there is room now) when the queue has
-  // room again after Submit answered ResourceExhausted: a streaming handler stops reading and
-  // resumes from here, instead of polling.
-  void OnRoom(std::function<void()> f);
+  // Runs `f` once when the queue can take a batch of `observations` — by the same rule Submit
+  // applies — on the committer thread, or at once when it can now. A streaming handler whose
+  // Submit was refused stops reading and resumes from here, instead of polling.
+  void OnRoom(uint64_t observations, std::function<void()> f);
   // Checkpoints now and waits.
   absl::Status Checkpoint();
   // Republishes every dynamic state's P with its best order (the update job's core), logged so that
@@ -158,6 +158,11 @@ class MapStore {
   // Classifies, encodes and splits a batch.
   Pending Prepare(ObservationBatch batch, AckCallback done) const;
   void IndexLabels(std::span<const StateLabel> labels);
+  // Whether the queue takes n more observations. One batch is always let in, however big, so that
+  // a single huge scan is not refused forever. REQUIRES: queue_mutex_ held.
+  bool FitsLocked(uint64_t n) const {
+    return queued_observations_ == 0 || queued_observations_ + n <= options_.max_queued_observations;
+  }
   const Shard& ShardFor(uint64_t key) const { return *shards_[ShardOf(key, info_.shards)]; }
 
   const MapInfo info_;

@@ -267,13 +267,16 @@ TEST(MapStoreTest, RefusesWhenBehindAndCallsBackWhenThereIsRoom) {
   int refused = 0;
   std::atomic<bool> room = false;
   for (uint64_t i = 0; i < 200 && refused == 0; ++i) {
-    const absl::Status s = (*store)->Submit(testing::SweepScan(map, 1, i, 900), [&](auto ack) {
+    ObservationBatch scan = testing::SweepScan(map, 1, i, 900);
+    const uint64_t n = scan.observation_count();
+    const absl::Status s = (*store)->Submit(std::move(scan), [&](auto ack) {
       EXPECT_TRUE(ack.ok());
       ++acked;
     });
     if (absl::IsResourceExhausted(s)) {
       ++refused;
-      (*store)->OnRoom([&] { room = true; });
+      // The queue holds a 900-observation batch: a second does not fit until the committer takes it.
+      (*store)->OnRoom(n, [&] { room = true; });
     }
   }
   ASSERT_EQ(refused, 1) << "200 batches of 900 against a queue of 1000 must overflow once";

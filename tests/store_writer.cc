@@ -42,7 +42,7 @@ absl::Status WriteBatches(const std::string& data_dir, const std::string& map,
     absl::Status submitted = (*opened)->Submit(batch, done);
     while (absl::IsResourceExhausted(submitted)) {  // backpressure: wait for room
       std::promise<void> room;
-      (*opened)->OnRoom([&room] { room.set_value(); });
+      (*opened)->OnRoom(batch.observation_count(), [&room] { room.set_value(); });
       room.get_future().wait();
       submitted = (*opened)->Submit(batch, done);
     }
