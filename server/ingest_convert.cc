@@ -16,10 +16,6 @@ using storage::MapInfo;
 using storage::MapKind;
 using storage::ObservationBatch;
 
-// storage::ValidateBatch's limit on a label's name and group; checked here too so that the message
-// names the proto's field rather than storage's labels[i].
-constexpr size_t kMaxLabelBytes = 256;
-
 const std::string& NoLabel() {
   static const std::string* const none = new std::string();
   return *none;
@@ -42,9 +38,11 @@ absl::Status CheckOptionalLength(absl::string_view field, size_t got, absl::stri
                               of.substr(0, of.size() - 1), ")"));
 }
 
+// storage::ValidateBatch checks the same limit; checked here too so that the message names the
+// proto's field rather than storage's labels[i].
 absl::Status CheckLabel(absl::string_view field, int i, const std::string& text) {
-  if (text.size() <= kMaxLabelBytes) return absl::OkStatus();
-  return Invalid(absl::StrCat(field, "[", i, "] has ", text.size(), " bytes; at most ", kMaxLabelBytes, " allowed"));
+  if (text.size() <= storage::kMaxLabelLength) return absl::OkStatus();
+  return Invalid(absl::StrCat(field, "[", i, "] has ", text.size(), " bytes; at most ", storage::kMaxLabelLength, " allowed"));
 }
 
 absl::Status CheckKind(const MapInfo& map, absl::string_view what, MapKind wanted) {

@@ -11,7 +11,6 @@ namespace fremen::storage {
 
 namespace {
 constexpr uint8_t kBatchVersion = 1;
-constexpr size_t kMaxLabelLength = 256;
 // A batch is one message of at most a few hundred MB; more observations than this is corruption.
 constexpr uint64_t kMaxBatchObservations = 1ull << 28;
 

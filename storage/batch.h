@@ -72,6 +72,8 @@ struct BatchAck {
 };
 
 inline constexpr size_t kMaxReportedRejections = 16;
+// The longest name or group of a state, bytes.
+inline constexpr size_t kMaxLabelLength = 256;
 
 // Checks what makes the whole batch unusable (the message names the field): the time (finite,
 // within ±1e13 s), mismatched lengths, a patch outside the grid or with the wrong value count,

@@ -405,17 +405,18 @@ void MapStore::IndexLabels(std::span<const StateLabel> labels) {
 absl::StatusOr<uint64_t> MapStore::DoPublish(const std::function<void(uint64_t, uint64_t)>& progress) {
   // The committer has logged and synced the publication's record already.
   std::vector<uint64_t> published(shards_.size());
-  std::vector<std::atomic<uint64_t>> done(shards_.size());
+  std::vector<uint64_t> done(shards_.size());  // guarded by progress_mutex
   uint64_t total = 0;
   for (const auto& shard : shards_) total += shard->Stats().dynamic_states;
   std::mutex progress_mutex;  // progress is reported from every shard's thread
   workers_->RunOnAll([&](uint32_t s) {
     published[s] = shards_[s]->PublishAll([&](uint64_t shard_done) {
-      done[s] = shard_done;
       if (!progress) return;
-      uint64_t all = 0;
-      for (const auto& d : done) all += d;
+      // Summed under the lock, so that reports from the shards' threads never go backwards.
       std::lock_guard lock(progress_mutex);
+      done[s] = shard_done;
+      uint64_t all = 0;
+      for (const uint64_t d : done) all += d;
       progress(all, total);
     });
   });
