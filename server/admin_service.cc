@@ -263,6 +263,11 @@ absl::Status AdminServiceImpl::FillStatus(v1::GetServerStatusResponse& response)
   for (const storage::MapInfo& info : *maps) {
     auto map = (*store)->Map(info.name);
     if (!map.ok()) continue;  // deleted meanwhile
+    if (const absl::Status fault = (*map)->WriteError(); !fault.ok()) {
+      v1::MapFault& failed = *response.add_failed_maps();
+      failed.set_map(info.name);
+      failed.set_error(fault.ToString());
+    }
     const storage::MapStats stats = (*map)->Stats();
     response.set_state_count(response.state_count() + stats.totals.states);
     response.set_dynamic_state_count(response.dynamic_state_count() + stats.totals.dynamic_states);

@@ -2,6 +2,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_cat.h"
@@ -12,6 +13,23 @@ namespace fremen::server {
 namespace {
 
 std::string FlagOf(absl::string_view key) { return absl::StrCat("--", absl::StrReplaceAll(key, {{"_", "-"}})); }
+
+// The arguments after the program's name, in the reversed order CLI11's vector parse expects, with
+// `--flag=` split into `--flag` and an empty value: CLI11 would otherwise take the next argument
+// as the value, while `--update-schedule=` means "an empty schedule" (never).
+std::vector<std::string> ArgumentsForCli11(int argc, const char* const* argv) {
+  std::vector<std::string> args;
+  for (int i = argc - 1; i >= 1; --i) {
+    const absl::string_view arg = argv[i];
+    if (arg.size() > 3 && arg.substr(0, 2) == "--" && arg.back() == '=') {
+      args.emplace_back();
+      args.emplace_back(arg.substr(0, arg.size() - 1));
+    } else {
+      args.emplace_back(arg);
+    }
+  }
+  return args;
+}
 
 }  // namespace
 
@@ -39,7 +57,8 @@ CommandLine ParseCommandLine(int argc, const char* const* argv, std::ostream& ou
   }
 
   try {
-    app.parse(argc, argv);
+    std::vector<std::string> args = ArgumentsForCli11(argc, argv);
+    app.parse(args);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e, out, err);
     return {std::nullopt, code == 0 ? kExitOk : kExitBadConfig};

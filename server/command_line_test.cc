@@ -62,6 +62,14 @@ TEST_F(CommandLineTest, FlagsOverrideTheFileWhichOverridesTheDefaults) {
   EXPECT_EQ(outcome.result.config->keepalive_time, absl::Seconds(45));
 }
 
+TEST_F(CommandLineTest, FlagWithEqualsAndNothingAfterItSetsAnEmptyValue) {
+  // `--update-schedule=` disables the schedule; the next argument stays an argument of its own.
+  const Outcome outcome = Parse({"--update-schedule=", "--data-dir=/srv/fremen"});
+  ASSERT_TRUE(outcome.result.config.has_value()) << outcome.err;
+  EXPECT_EQ(outcome.result.config->update_schedule, "");
+  EXPECT_EQ(outcome.result.config->data_dir, "/srv/fremen");
+}
+
 TEST_F(CommandLineTest, HelpListsEverySettingAsAFlag) {
   const Outcome outcome = Parse({"--help"});
   EXPECT_FALSE(outcome.result.config.has_value());

@@ -11,6 +11,7 @@
 #include "absl/strings/string_view.h"
 #include "fremen/v1/common.pb.h"
 #include "google/protobuf/repeated_field.h"
+#include "storage/batch.h"
 #include "storage/map_info.h"
 #include "storage/shard.h"
 
@@ -27,8 +28,8 @@ std::span<const T> SpanOf(const google::protobuf::RepeatedField<T>& field) {
 // daemon configured with a smaller limit refuses larger answers with gRPC's own RESOURCE_EXHAUSTED).
 inline constexpr uint64_t kMaxPredictions = uint64_t{1} << 21;
 
-// InvalidArgument unless t is finite and within ±1e13 s (storage's kMaxAbsTime).
-absl::Status CheckTime(double t, absl::string_view field);
+// InvalidArgument unless t is a time the service accepts: finite, in [0, 1e13] s.
+using storage::CheckTime;
 // The same for every element; the error names `field[i]`.
 absl::Status CheckTimes(std::span<const double> times, absl::string_view field);
 // InvalidArgument unless c is in [lo, hi] (NaN is not).

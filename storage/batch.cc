@@ -17,10 +17,15 @@ constexpr uint64_t kMaxBatchObservations = 1ull << 28;
 bool ValueOk(float v) { return v >= 0.0f && v <= 1.0f; }  // false for NaN
 }  // namespace
 
+absl::Status CheckTime(double t, absl::string_view field) {
+  // Written so that NaN fails too.
+  if (t >= 0.0 && t <= model::kMaxAbsTime) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat(field, " must be a time in seconds since the Unix epoch, finite, in [0, 1e13]; got ", t));
+}
+
 absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch) {
-  if (!std::isfinite(batch.time) || std::fabs(batch.time) > model::kMaxAbsTime) {
-    return absl::InvalidArgumentError(absl::StrCat("time must be a finite time within ±1e13 s, got ", batch.time));
-  }
+  if (absl::Status s = CheckTime(batch.time, "time"); !s.ok()) return s;
   if (batch.keys.size() != batch.values.size()) {
     return absl::InvalidArgumentError(absl::StrCat("values must hold one value per state: ", batch.values.size(),
                                                    " values for ", batch.keys.size(), " states"));

@@ -14,6 +14,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "storage/map_info.h"
 
 namespace fremen::storage {
@@ -75,8 +76,12 @@ inline constexpr size_t kMaxReportedRejections = 16;
 // The longest name or group of a state, bytes.
 inline constexpr size_t kMaxLabelLength = 256;
 
-// Checks what makes the whole batch unusable (the message names the field): the time (finite,
-// within ±1e13 s), mismatched lengths, a patch outside the grid or with the wrong value count,
+// The times the service accepts, for observations and for queries alike: seconds since the Unix
+// epoch, finite, in [0, 1e13] (SPEC §4: NaN, infinite, negative or absurd times are bad input;
+// the model maths itself accepts ±1e13). InvalidArgument naming `field` otherwise.
+absl::Status CheckTime(double t, absl::string_view field);
+
+// Checks what makes the whole batch unusable (the message names the field): the time (CheckTime), mismatched lengths, a patch outside the grid or with the wrong value count,
 // labels on a grid. Per-observation problems are not errors: see Classify.
 absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch);
 

@@ -253,6 +253,11 @@ absl::Status MapStore::Close() {
   return write_error_;
 }
 
+absl::Status MapStore::WriteError() const {
+  std::lock_guard lock(queue_mutex_);
+  return write_error_;
+}
+
 void MapStore::Latch(const absl::Status& status) {
   std::lock_guard lock(queue_mutex_);
   if (write_error_.ok()) write_error_ = status;

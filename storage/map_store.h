@@ -94,6 +94,9 @@ class MapStore {
   absl::StatusOr<uint64_t> PublishModels(std::function<void(uint64_t, uint64_t)> progress = nullptr);
   // Stops accepting writes, finishes the queued ones and checkpoints. Idempotent.
   absl::Status Close();
+  // OK, or the error that stopped all writes to the map (a failed log sync, commit or checkpoint:
+  // latched, so that nothing is acknowledged that might not be durable). Reads still work.
+  absl::Status WriteError() const;
 
   // --- reads ---
   // p at every (time, key): out[i·keys + j] for times[i], keys[j].
@@ -177,7 +180,7 @@ class MapStore {
   DedupTable applied_dedup_;  // applier only: what was applied, recorded by checkpoints
   uint64_t applied_lsn_ = 0;  // applier only
 
-  std::mutex queue_mutex_;
+  mutable std::mutex queue_mutex_;
   std::condition_variable queue_ready_;
   std::deque<Pending> queue_;
   uint64_t queued_observations_ = 0;

@@ -236,10 +236,12 @@ TEST(MapStoreTest, AFailedLogSyncIsNeverAcknowledgedAndLatches) {
   auto store = MapStore::Open(map, dir.path(), options);
   ASSERT_TRUE(store.ok());
   ASSERT_TRUE((*store)->Write(testing::SweepScan(map, 1, 0, 50)).ok());
+  EXPECT_TRUE((*store)->WriteError().ok());
   disk_fails = true;
   const auto failed = (*store)->Write(testing::SweepScan(map, 1, 1, 50));
   ASSERT_FALSE(failed.ok());
   EXPECT_NE(failed.status().message().find("injected"), std::string::npos);
+  EXPECT_NE((*store)->WriteError().message().find("injected"), std::string::npos);
   disk_fails = false;  // even once the disk recovers, what was written is unknown: writes stay refused
   EXPECT_FALSE((*store)->Write(testing::SweepScan(map, 1, 2, 50)).ok());
   // Reads go on, and see exactly the acknowledged batch.

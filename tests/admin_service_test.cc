@@ -449,6 +449,7 @@ TEST_F(AdminServiceTest, ServerStatus) {
   EXPECT_FALSE(status.tokens_required());
   EXPECT_EQ(status.store_state(), v1::STORE_STATE_OPEN);
   EXPECT_GT(status.data_dir_free_bytes(), 0u);
+  EXPECT_EQ(status.failed_maps_size(), 0);  // a failing map is covered by MapStoreTest's fault injection
   ASSERT_EQ(status.last_updates_size(), 1);
   EXPECT_EQ(status.last_updates(0).name(), update.name());
   EXPECT_EQ(status.last_updates(0).update().states_published(), 2u);

@@ -51,10 +51,11 @@ TEST_F(FremendTest, HealthIsServingForTheServerAndEachService) {
   HealthResponse::ServingStatus serving;
   ASSERT_TRUE(Health("", &serving).ok());
   EXPECT_EQ(serving, HealthResponse::SERVING);
-  ASSERT_TRUE(Health("fremen.v1.MapService", &serving).ok());
-  EXPECT_EQ(serving, HealthResponse::SERVING);
-  ASSERT_TRUE(Health("fremen.v1.QueryService", &serving).ok());
-  EXPECT_EQ(serving, HealthResponse::SERVING);
+  for (const char* service : {"fremen.v1.MapService", "fremen.v1.IngestService", "fremen.v1.QueryService",
+                              "fremen.v1.AdminService"}) {
+    ASSERT_TRUE(Health(service, &serving).ok()) << service;
+    EXPECT_EQ(serving, HealthResponse::SERVING) << service;
+  }
   // Services the daemon does not serve are unknown to health, as to gRPC.
   EXPECT_EQ(Health("fremen.v1.NoSuchService", &serving).error_code(), grpc::StatusCode::NOT_FOUND);
 }
@@ -65,7 +66,8 @@ TEST_F(FremendTest, ReflectionListsTheServices) {
   const reflection::ServerReflectionResponse response = Reflect(request);
   std::vector<std::string> names;
   for (const auto& service : response.list_services_response().service()) names.push_back(service.name());
-  EXPECT_THAT(names, ::testing::IsSupersetOf({"fremen.v1.MapService", "fremen.v1.QueryService",
+  EXPECT_THAT(names, ::testing::IsSupersetOf({"fremen.v1.MapService", "fremen.v1.IngestService",
+                                              "fremen.v1.QueryService", "fremen.v1.AdminService",
                                               "grpc.health.v1.Health", "grpc.reflection.v1alpha.ServerReflection"}));
 }
 

@@ -132,6 +132,8 @@ TEST_F(QueryServiceTest, PredictBadInput) {
   EXPECT_STATUS(Predict(r, &response), INVALID_ARGUMENT, "times[0]");
   r.set_times(0, -2e13);
   EXPECT_STATUS(Predict(r, &response), INVALID_ARGUMENT, "times[0]");
+  r.set_times(0, -1);
+  EXPECT_STATUS(Predict(r, &response), INVALID_ARGUMENT, "times[0] must be a time in seconds since the Unix epoch");
 
   r = base();
   r.mutable_options()->set_order(6);  // L = 5
