@@ -13,9 +13,11 @@ batches sent but not yet answered, so send() blocks instead of queueing without 
 
 A batch refused as a whole comes back as an Ack whose `error` is set (the stream goes on); a stream
 that fails (unknown map, missing token, daemon gone) makes the next send/wait/close raise the
-fremen.Error. Thread-safety: one thread sends; wait/close from that thread too.
+fremen.Error. Its unanswered() batches may then have been applied or not: a new session of the
+same writer id resend()s them, and the daemon applies each exactly once. Thread-safety: one thread sends; wait/close from that thread too.
 """
 
+import collections
 import dataclasses
 import queue
 import threading
@@ -76,8 +78,7 @@ class IngestSession:
         self._max_in_flight = max_in_flight
         self._requests = queue.Queue()
         self._lock = threading.Condition()
-        self._sent = 0
-        self._answered = 0
+        self._unanswered = collections.deque()  # batches sent, oldest first, not yet answered
         self._new_acks = []
         self._failure = None  # the fremen.Error that ended the stream
         self._ended = False  # the daemon's side of the stream ended
@@ -133,6 +134,28 @@ class IngestSession:
             request.patch.probabilities = bytes(probabilities)
         return self._put(request)
 
+    def resend(self, batches):
+        """Sends again batches that another session of the same writer sent but never saw answered
+        (its unanswered() after the stream failed), with their own sequence numbers: the daemon
+        applies those it lacks and answers the others with duplicate=True, so that nothing is lost
+        or applied twice. Later send()s continue after the highest sequence resent."""
+        for batch in batches:
+            if batch.writer_id != self.writer_id:
+                raise errors.InvalidArgument(
+                    f"resend: batch {batch.sequence} is of writer {batch.writer_id}, this session writes as "
+                    f"{self.writer_id}: open it with ingest(..., writer_id={batch.writer_id})")
+            request = ingest_pb2.IngestRequest()
+            request.CopyFrom(batch)
+            request.map = self.map
+            self.next_sequence = max(self.next_sequence, request.sequence + 1)
+            self._put(request)
+
+    def unanswered(self):
+        """The batches (fremen.v1.IngestRequest) sent and not answered yet, oldest first: after the
+        stream failed, the ones to resend() in a new session."""
+        with self._lock:
+            return list(self._unanswered)
+
     def _new_request(self, time, sequence):
         if sequence is None:
             sequence = self.next_sequence
@@ -143,9 +166,9 @@ class IngestSession:
         with self._lock:
             if self._closed:
                 raise errors.error_for(grpc.StatusCode.FAILED_PRECONDITION, "the ingest session is closed")
-            self._lock.wait_for(lambda: self._failure or self._ended or self._sent - self._answered < self._max_in_flight)
+            self._lock.wait_for(lambda: self._failure or self._ended or len(self._unanswered) < self._max_in_flight)
             self._raise_if_ended()
-            self._sent += 1
+            self._unanswered.append(request)
         self._requests.put(request)
         return request.sequence
 
@@ -160,7 +183,7 @@ class IngestSession:
             for response in self._call:
                 with self._lock:
                     self._new_acks.append(Ack.from_proto(response))
-                    self._answered += 1
+                    self._unanswered.popleft()  # answers come in the order of the batches
                     self._lock.notify_all()
         except grpc.RpcError as error:
             with self._lock:
@@ -175,9 +198,9 @@ class IngestSession:
         # Called with the lock held.
         if self._failure is not None:
             raise self._failure
-        if self._ended and self._answered < self._sent:
+        if self._ended and self._unanswered:
             raise errors.error_for(grpc.StatusCode.UNKNOWN,
-                                   f"the ingest stream ended with {self._sent - self._answered} batches unanswered")
+                                   f"the ingest stream ended with {len(self._unanswered)} batches unanswered")
 
     def wait(self, timeout=None):
         """Blocks until every batch sent so far is answered; returns the Acks that came since the
@@ -185,12 +208,12 @@ class IngestSession:
         DeadlineExceeded after `timeout` seconds."""
         deadline = None if timeout is None else time_module.monotonic() + timeout
         with self._lock:
-            while self._answered < self._sent and not self._failure and not self._ended:
+            while self._unanswered and not self._failure and not self._ended:
                 remaining = None if deadline is None else deadline - time_module.monotonic()
                 if remaining is not None and remaining <= 0:
                     raise errors.error_for(
                         grpc.StatusCode.DEADLINE_EXCEEDED,
-                        f"{self._sent - self._answered} batches still unanswered after {timeout} s")
+                        f"{len(self._unanswered)} batches still unanswered after {timeout} s")
                 self._lock.wait(remaining)
             self._raise_if_ended()
             acks, self._new_acks = self._new_acks, []

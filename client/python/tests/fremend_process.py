@@ -129,8 +129,15 @@ class DaemonTestCase(unittest.TestCase):
         if self.tls:
             self.certificate = self.make_certificate()
             args += ["--tls-cert-file", self.certificate, "--tls-key-file", self.path("key.pem")]
+        self._daemon_args = args
         self.daemon = FremendProcess.start(self.path("data"), args, tls_root=self.certificate)
         self.addCleanup(self.stop_daemon)
+        self.client = self.connect(token=self.token, tls=self.certificate)
+
+    def restart_daemon(self):
+        """A new daemon on the same data directory (after the old one stopped or was killed), on a
+        new port; self.client talks to it."""
+        self.daemon = FremendProcess.start(self.path("data"), self._daemon_args, tls_root=self.certificate)
         self.client = self.connect(token=self.token, tls=self.certificate)
 
     def write(self, name, text):

@@ -3,6 +3,8 @@
 duplicates, many batches in flight, and a stream that fails."""
 
 import math
+import os
+import signal
 import unittest
 
 import grpc
@@ -144,6 +146,36 @@ class IngestTest(DaemonTestCase):
         with self.assertRaises(fremen.FailedPrecondition):
             session.send(T, [1], names=["a"])
         self.assertEqual(self.client.stats("doors").observations, 1)  # what was acknowledged stays
+
+    def test_batches_unanswered_when_the_daemon_died_are_resent_exactly_once(self):
+        self.client.create_map("doors")
+        session = self.client.ingest("doors", writer_id=5)
+        for i in range(5):
+            session.send(T + i, [1], names=["a"])
+        self.assertEqual(len(session.wait()), 5)
+        # A stopped daemon answers nothing: the next batches stay unanswered, until it dies.
+        os.kill(self.daemon.process.pid, signal.SIGSTOP)
+        for i in range(5, 8):
+            session.send(T + i, [1], names=["a"])
+        self.daemon.kill()
+        with self.assertRaises(fremen.Unavailable):
+            session.wait(timeout=30)
+        unanswered = session.unanswered()
+        self.assertEqual([b.sequence for b in unanswered], [6, 7, 8])
+
+        self.restart_daemon()
+        with self.client.ingest("doors", writer_id=5) as resumed:
+            resumed.resend(unanswered)
+            resumed.resend(unanswered[:1])  # applied by now: answered as a duplicate
+            self.assertEqual(resumed.send(T + 8, [1], names=["a"]), 9)
+            acks = resumed.wait()
+        self.assertEqual([(a.sequence, a.duplicate) for a in acks],
+                         [(6, False), (7, False), (8, False), (6, True), (9, False)])
+        self.assertEqual(self.client.stats("doors").observations, 9)
+        with self.client.ingest("doors", writer_id=6) as other_writer:
+            with self.assertRaises(fremen.InvalidArgument) as raised:
+                other_writer.resend(unanswered)
+        self.assertIn("writer_id=5", raised.exception.message)
 
 
 if __name__ == "__main__":
