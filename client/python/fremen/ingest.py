@@ -92,8 +92,9 @@ class IngestSession:
     def send(self, time, values, *, ids=None, names=None, groups=None, cells=None, points=None, sequence=None):
         """Sends one batch: observations `values` (each in [0, 1]) at `time` (seconds) of the states
         named by exactly one of ids= / names= (generic maps; groups= optionally labels each state
-        the first time it is seen) or cells= / points= (grid maps). Returns its sequence number."""
-        request = self._new_request(time, sequence)
+        the first time it is seen) or cells= / points= (grid maps). sequence: the batch's number
+        instead of the next one (later batches continue above it). Returns its sequence number."""
+        request = ingest_pb2.IngestRequest(map=self.map, writer_id=self.writer_id, time=time)
         values = [float(v) for v in values]
         kind = refs.chosen_kind({"ids": ids, "names": names, "cells": cells, "points": points}, "send")
         if groups is not None and kind not in ("ids", "names"):
@@ -113,7 +114,7 @@ class IngestSession:
         else:
             request.points.points.CopyFrom(refs.points(points))
             request.points.values.extend(values)
-        return self._put(request)
+        return self._put(request, sequence)
 
     def send_patch(self, time, origin, size, *, values=None, probabilities=None, sequence=None):
         """Sends a dense box of a grid map: `origin` (x, y[, z]) its first cell, `size` (nx, ny[, nz])
@@ -122,7 +123,7 @@ class IngestSession:
         per cell, s = byte / 255). Returns its sequence number."""
         if (values is None) == (probabilities is None):
             raise errors.InvalidArgument("send_patch needs exactly one of values= and probabilities=")
-        request = self._new_request(time, sequence)
+        request = ingest_pb2.IngestRequest(map=self.map, writer_id=self.writer_id, time=time)
         o = list(origin) + [0] * (3 - len(origin))
         s = list(size) + [1] * (3 - len(size))
         request.patch.origin.CopyFrom(common_pb2.CellIndex(x=o[0], y=o[1], z=o[2]))
@@ -132,7 +133,7 @@ class IngestSession:
             request.patch.values.extend(float(v) for v in flat)
         else:
             request.patch.probabilities = bytes(probabilities)
-        return self._put(request)
+        return self._put(request, sequence)
 
     def resend(self, batches):
         """Sends again batches that another session of the same writer sent but never saw answered
@@ -147,8 +148,7 @@ class IngestSession:
             request = ingest_pb2.IngestRequest()
             request.CopyFrom(batch)
             request.map = self.map
-            self.next_sequence = max(self.next_sequence, request.sequence + 1)
-            self._put(request)
+            self._put(request, request.sequence)
 
     def unanswered(self):
         """The batches (fremen.v1.IngestRequest) sent and not answered yet, oldest first: after the
@@ -156,18 +156,17 @@ class IngestSession:
         with self._lock:
             return list(self._unanswered)
 
-    def _new_request(self, time, sequence):
-        if sequence is None:
-            sequence = self.next_sequence
-        self.next_sequence = sequence + 1
-        return ingest_pb2.IngestRequest(map=self.map, writer_id=self.writer_id, sequence=sequence, time=time)
-
-    def _put(self, request):
+    def _put(self, request, sequence):
+        """Numbers the batch (`sequence`, or the next one when None) and queues it for the stream;
+        blocks while max_in_flight batches are unanswered. The batch's sequence number."""
         with self._lock:
             if self._closed:
                 raise errors.error_for(grpc.StatusCode.FAILED_PRECONDITION, "the ingest session is closed")
             self._lock.wait_for(lambda: self._failure or self._ended or len(self._unanswered) < self._max_in_flight)
             self._raise_if_ended()
+            request.sequence = self.next_sequence if sequence is None else sequence
+            # Numbers only go up: a writer's batch at or below its highest applied one is a retry.
+            self.next_sequence = max(self.next_sequence, request.sequence + 1)
             self._unanswered.append(request)
         self._requests.put(request)
         return request.sequence

@@ -128,6 +128,7 @@ class IngestTest(DaemonTestCase):
             with self.assertRaises(fremen.InvalidArgument):
                 session.send_patch(T, (0, 0), (1, 1))
             self.assertEqual(session.wait(), [])
+            self.assertEqual(session.send(T, [1], names=["a"]), 1)  # refusals used no sequence number
 
     def test_sending_after_close_is_refused(self):
         self.client.create_map("doors")
