@@ -1,0 +1,68 @@
+"""Dense results (predictions, regions) as numpy arrays when numpy is importable, and as FlatArray
+(a flat list and a shape) when it is not, so that the package works without numpy.
+"""
+
+import math
+
+try:
+    import numpy
+except ImportError:  # numpy is optional
+    numpy = None
+
+
+def numpy_available():
+    return numpy is not None
+
+
+class FlatArray:
+    """Values in C order (the last index fastest) and their shape: what a numpy array would hold.
+
+    array[i, j, ...] reads one element; tolist() gives nested lists, as numpy's tolist() does.
+    """
+
+    def __init__(self, values, shape):
+        if len(values) != math.prod(shape):
+            raise ValueError(f"{len(values)} values do not fill shape {shape}")
+        self.values = values
+        self.shape = tuple(shape)
+
+    def __len__(self):
+        return self.shape[0]
+
+    def __getitem__(self, index):
+        if not isinstance(index, tuple):
+            index = (index,)
+        if len(index) != len(self.shape):
+            raise IndexError(f"FlatArray of shape {self.shape} needs {len(self.shape)} indices, got {len(index)}")
+        offset = 0
+        for i, n in zip(index, self.shape):
+            if not -n <= i < n:
+                raise IndexError(f"index {index} outside shape {self.shape}")
+            offset = offset * n + (i % n)
+        return self.values[offset]
+
+    def tolist(self):
+        def nest(values, shape):
+            if len(shape) == 1:
+                return list(values)
+            step = len(values) // shape[0]
+            return [nest(values[i * step:(i + 1) * step], shape[1:]) for i in range(shape[0])]
+        return nest(self.values, self.shape)
+
+    def __repr__(self):
+        return f"FlatArray(shape={self.shape})"
+
+
+def shaped(values, shape, dtype, use_numpy):
+    """`values` (a sequence in C order) as a numpy array of `dtype` ("float32", "uint8", "bool") and
+    `shape` when `use_numpy`, else as a FlatArray."""
+    if use_numpy:
+        return numpy.asarray(values, dtype=dtype).reshape(shape)
+    return FlatArray(list(values), shape)
+
+
+def shaped_bytes(data, shape, use_numpy):
+    """Bytes (one uint8 per element) shaped as by shaped()."""
+    if use_numpy:
+        return numpy.frombuffer(data, dtype=numpy.uint8).reshape(shape).copy()
+    return FlatArray(list(data), shape)

@@ -1,0 +1,318 @@
+"""fremen.connect() and the Client: every call of the fremen.v1 API a map user needs, with Python
+arguments in and Python (or numpy) values out. Each call names its map in the request's `map`
+field and in the x-fremen-map header (so that a proxy can route on it), sends the bearer token when
+one was given, and turns a failed call into a fremen.Error subclass.
+
+Thread-safety: a Client may be shared by threads (gRPC channels and stubs are thread-safe); an
+IngestSession belongs to one thread.
+"""
+
+import dataclasses
+import math
+import secrets
+import time as time_module
+
+import grpc
+
+from fremen import arrays, errors, refs
+from fremen.ingest import IngestSession
+from fremen.model import StateModel
+from fremen.v1 import (admin_pb2, admin_pb2_grpc, common_pb2, ingest_pb2_grpc, maps_pb2, maps_pb2_grpc,
+                       query_pb2, query_pb2_grpc)
+
+DEFAULT_ADDRESS = "127.0.0.1:50051"
+
+
+def connect(address=DEFAULT_ADDRESS, token=None, tls=None, timeout=30.0, use_numpy=None):
+    """A Client of the fremend at `address` ("host:port").
+
+    token: a bearer token, sent as "authorization: Bearer <token>" (needed when the daemon has
+    tokens: a read token for queries, a write token for the rest).
+    tls: None/False for plaintext, True for TLS with the system's root certificates, or the path of
+    a PEM file of root certificates to trust (e.g. the daemon's self-signed certificate).
+    timeout: seconds each unary call may take (None = no limit); ingest streams have their own.
+    use_numpy: None = numpy arrays when numpy is importable, False = FlatArray always.
+    """
+    if tls is None or tls is False:
+        channel = grpc.insecure_channel(address)
+    else:
+        root_certificates = None
+        if tls is not True:
+            with open(tls, "rb") as pem:
+                root_certificates = pem.read()
+        channel = grpc.secure_channel(address, grpc.ssl_channel_credentials(root_certificates))
+    return Client(channel, token=token, timeout=timeout, use_numpy=use_numpy)
+
+
+@dataclasses.dataclass(frozen=True)
+class Prediction:
+    """Predict's answer. probabilities[i, j] is p of states[j] at times[i] (shape times × states);
+    None when states_only. states: p ≥ confidence, same shape, when a confidence was given.
+    unobserved: indices j of the states the map has never observed (they predict 0.5)."""
+    probabilities: object
+    states: object
+    unobserved: list
+
+
+@dataclasses.dataclass(frozen=True)
+class ScoredState:
+    id: int
+    name: str
+    probability: float
+
+
+@dataclasses.dataclass(frozen=True)
+class AnomalyCheck:
+    """One element per observation checked."""
+    probabilities: list
+    anomalous: list
+
+
+_REGION_OUTPUTS = {
+    "float": (query_pb2.REGION_OUTPUT_FLOAT, "float32"),
+    "uint8": (query_pb2.REGION_OUTPUT_UINT8, "uint8"),
+    "entropy": (query_pb2.REGION_OUTPUT_ENTROPY, "float32"),
+    "states": (query_pb2.REGION_OUTPUT_STATES, "uint8"),
+}
+
+_CRITERIA = {
+    "threshold": maps_pb2.ERROR_CRITERION_THRESHOLD,
+    "squared": maps_pb2.ERROR_CRITERION_SQUARED,
+}
+
+
+class Client:
+    """Made by fremen.connect(). Usable as a context manager (closes the channel)."""
+
+    def __init__(self, channel, token=None, timeout=30.0, use_numpy=None):
+        self._channel = channel
+        self._auth = [("authorization", f"Bearer {token}")] if token else []
+        self._timeout = timeout
+        self._use_numpy = arrays.numpy_available() if use_numpy is None else use_numpy
+        if self._use_numpy and not arrays.numpy_available():
+            raise errors.InvalidArgument("use_numpy=True, but numpy cannot be imported")
+        self._maps = maps_pb2_grpc.MapServiceStub(channel)
+        self._ingest = ingest_pb2_grpc.IngestServiceStub(channel)
+        self._query = query_pb2_grpc.QueryServiceStub(channel)
+        self._admin = admin_pb2_grpc.AdminServiceStub(channel)
+
+    def close(self):
+        self._channel.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc_info):
+        self.close()
+        return False
+
+    # --- plumbing ---
+
+    def _metadata(self, map_name=None):
+        return self._auth + ([("x-fremen-map", map_name)] if map_name else [])
+
+    def _call(self, method, request, map_name=None):
+        try:
+            return method(request, metadata=self._metadata(map_name), timeout=self._timeout)
+        except grpc.RpcError as error:
+            raise errors.error_from_rpc(error) from None
+
+    # --- maps ---
+
+    def create_map(self, name, *, size=None, resolution=None, origin=None, kind=None, longest_period=None,
+                   period_count=None, floor_periods=False, periods=None, max_order=None, persistence=None,
+                   error_half_life=None, criterion=None, lossless_sampling=0.0, lossless_origin=0.0, shards=0):
+        """Creates a map and returns it (a fremen.v1.Map with every default filled in).
+
+        A grid map when `size` is given: (nx, ny) or (nx, ny, nz) cells of `resolution` metres from
+        `origin` (x, y[, z]) metres; a generic map (states by id or name) otherwise. `kind` ("grid"
+        or "generic") may say so explicitly. Model settings left None take the daemon's defaults:
+        periods = `period_count` harmonics of `longest_period` seconds (24 of a week), or the
+        explicit list `periods`; `max_order` 5; `persistence` True; `error_half_life` a week;
+        `criterion` "threshold" or "squared"; `lossless_sampling` seconds (0 = no lossless
+        history); `shards` 0 = the daemon's default.
+        """
+        if kind is None:
+            kind = "grid" if size is not None else "generic"
+        kinds = {"grid": maps_pb2.MAP_KIND_GRID, "generic": maps_pb2.MAP_KIND_GENERIC}
+        if kind not in kinds:
+            raise errors.InvalidArgument(f"kind must be 'grid' or 'generic', got {kind!r}")
+        spec = maps_pb2.Map(name=name, kind=kinds[kind], lossless_sampling_seconds=lossless_sampling,
+                            lossless_origin=lossless_origin, shards=shards)
+        if kind == "grid":
+            if size is None or resolution is None:
+                raise errors.InvalidArgument("a grid map needs size=(nx, ny[, nz]) and resolution= (metres)")
+            s = list(size) + [0] * (3 - len(size))
+            spec.grid.resolution = resolution
+            spec.grid.size.CopyFrom(common_pb2.GridSize(x=s[0], y=s[1], z=s[2]))
+            if origin is not None:
+                o = list(origin) + [0.0] * (3 - len(origin))
+                spec.grid.origin.CopyFrom(common_pb2.Point(x=o[0], y=o[1], z=o[2]))
+        if longest_period is not None:
+            spec.periods.longest_seconds = longest_period
+        if period_count is not None:
+            spec.periods.count = period_count
+        spec.periods.floor_periods = floor_periods
+        if periods is not None:
+            spec.periods.explicit_seconds.extend(periods)
+        if max_order is not None:
+            spec.max_order = max_order
+        if persistence is not None:
+            spec.persistence = persistence
+        if error_half_life is not None:
+            spec.error_half_life_seconds = error_half_life
+        if criterion is not None:
+            if criterion not in _CRITERIA:
+                raise errors.InvalidArgument(f"criterion must be 'threshold' or 'squared', got {criterion!r}")
+            spec.criterion = _CRITERIA[criterion]
+        return self._call(self._maps.CreateMap, maps_pb2.CreateMapRequest(map=spec), name).map
+
+    def get_map(self, name):
+        """The map (fremen.v1.Map). NotFound when there is none."""
+        return self._call(self._maps.GetMap, maps_pb2.GetMapRequest(map=name), name).map
+
+    def list_maps(self, page_size=0):
+        """Every map (fremen.v1.Map) in name order, fetched a page of `page_size` at a time."""
+        token = ""
+        while True:
+            page = self._call(self._maps.ListMaps, maps_pb2.ListMapsRequest(page_size=page_size, page_token=token))
+            yield from page.maps
+            token = page.next_page_token
+            if not token:
+                return
+
+    def delete_map(self, name):
+        """Deletes the map and all its data. NotFound when there is none."""
+        self._call(self._maps.DeleteMap, maps_pb2.DeleteMapRequest(map=name), name)
+
+    # --- ingest ---
+
+    def ingest(self, map_name, writer_id=None, first_sequence=1, max_in_flight=64, timeout=None):
+        """An IngestSession streaming batches into `map_name`.
+
+        (writer_id, sequence) identifies a batch: a robot that reconnects and resends batches not
+        yet acknowledged must use the same writer_id and sequence numbers (the daemon answers a
+        batch already applied with duplicate=True). writer_id defaults to a random number, a new
+        writer. timeout: seconds the whole stream may last (None = no limit).
+        """
+        if writer_id is None:
+            writer_id = secrets.randbits(63) + 1
+        return IngestSession(self._ingest.Ingest, map_name, self._metadata(map_name), writer_id, first_sequence,
+                             max_in_flight, timeout)
+
+    # --- queries ---
+
+    def predict(self, map_name, times, *, ids=None, names=None, cells=None, points=None, persistence=False,
+                order=None, confidence=None, states_only=False):
+        """p(t) of many states (exactly one of ids=, names=, cells=, points=) at many `times` (a
+        number or a sequence, seconds). persistence: blend in the last observation (maps created
+        with persistence). order: evaluate at this order instead of each state's selected one.
+        confidence: also answer p ≥ confidence; states_only: only that."""
+        times = [float(times)] if isinstance(times, (int, float)) else [float(t) for t in times]
+        request = query_pb2.PredictRequest(map=map_name, states=refs.state_refs("predict", ids, names, cells, points),
+                                           times=times, options=refs.prediction_options(persistence, order),
+                                           states_only=states_only)
+        if confidence is not None:
+            request.confidence = confidence
+        response = self._call(self._query.Predict, request, map_name)
+        shape = (response.time_count, response.state_count)
+        probabilities = None
+        if not states_only:
+            probabilities = arrays.shaped(response.probabilities, shape, "float32", self._use_numpy)
+        states = None
+        if confidence is not None:
+            states = arrays.shaped(response.states, shape, "bool", self._use_numpy)
+        return Prediction(probabilities, states, list(response.unobserved))
+
+    def region(self, map_name, lo, hi, time, *, output="float", confidence=0.0, persistence=False, order=None,
+               chunk_cells=0):
+        """A box [lo, hi) of a grid at `time`, assembled from the daemon's chunks.
+
+        lo, hi: (x, y) on a 2-D grid, giving an array of shape (ny, nx); or (x, y, z), giving
+        (nz, ny, nx). Indexed [y, x] or [z, y, x]. output: "float" (p), "uint8" (round(255 p)),
+        "entropy" (bits) or "states" (p ≥ confidence as 0/1). A numpy array (float32 or uint8), or
+        a FlatArray without numpy.
+        """
+        if len(lo) != len(hi) or len(lo) not in (2, 3):
+            raise errors.InvalidArgument(f"lo and hi must both be (x, y) or (x, y, z), got {lo!r} and {hi!r}")
+        if output not in _REGION_OUTPUTS:
+            raise errors.InvalidArgument(f"output must be one of {', '.join(_REGION_OUTPUTS)}, got {output!r}")
+        kind, dtype = _REGION_OUTPUTS[output]
+        lo3 = list(lo) + [0] * (3 - len(lo))
+        hi3 = list(hi) + [0] * (3 - len(hi))
+        request = query_pb2.PredictRegionRequest(
+            map=map_name, lo=common_pb2.CellIndex(x=lo3[0], y=lo3[1], z=lo3[2]),
+            hi=common_pb2.CellIndex(x=hi3[0], y=hi3[1], z=hi3[2]), time=time,
+            options=refs.prediction_options(persistence, order), output=kind, confidence=confidence,
+            chunk_cells=chunk_cells)
+        extent = [max(h - l, 0) for l, h in zip(lo, hi)]
+        shape = tuple(reversed(extent))
+        floats = dtype == "float32"
+        values = None
+        filled = 0
+        try:
+            for chunk in self._query.PredictRegion(request, metadata=self._metadata(map_name), timeout=self._timeout):
+                if values is None:
+                    values = [0.0] * chunk.box_cells if floats else bytearray(chunk.box_cells)
+                part = chunk.float_values if floats else chunk.bytes_values
+                values[chunk.offset:chunk.offset + len(part)] = part
+                filled += len(part)
+        except grpc.RpcError as error:
+            raise errors.error_from_rpc(error) from None
+        if values is None or filled != len(values) or len(values) != math.prod(extent):
+            raise errors.Error(grpc.StatusCode.DATA_LOSS,
+                               f"the region's chunks covered {filled} cells of a box of {extent} cells")
+        if floats:
+            return arrays.shaped(values, shape, dtype, self._use_numpy)
+        return arrays.shaped_bytes(bytes(values), shape, self._use_numpy)
+
+    def model(self, map_name, *, id=None, name=None, cell=None, point=None, include_spectrum=False,  # noqa: A002
+              raw=False):
+        """One state's model (exactly one of id=, name=, cell=, point=) as a fremen.StateModel, or
+        the fremen.v1.StateModel when raw; None when the state was never observed."""
+        request = query_pb2.GetStateModelRequest(map=map_name, state=refs.state_ref("model", id, name, cell, point),
+                                                 include_spectrum=include_spectrum)
+        response = self._call(self._query.GetStateModel, request, map_name)
+        if not response.HasField("model"):
+            return None
+        if raw:
+            return response.model
+        return StateModel.from_proto(response.model)
+
+    def stats(self, map_name):
+        """The map's statistics (fremen.v1.MapStats: states, observations, bytes, orders, errors)."""
+        return self._call(self._query.GetMapStats, query_pb2.GetMapStatsRequest(map=map_name), map_name).stats
+
+    def top(self, map_name, group, time, n=10, *, persistence=False, order=None):
+        """The n states of `group` most likely to be 1 at `time`, most likely first (generic maps)."""
+        request = query_pb2.TopStatesRequest(map=map_name, group=group, time=time, n=n,
+                                             options=refs.prediction_options(persistence, order))
+        response = self._call(self._query.TopStates, request, map_name)
+        return [ScoredState(s.id, s.name, s.probability) for s in response.states]
+
+    def anomalies(self, map_name, values, times, confidence, *, ids=None, names=None, cells=None, points=None,
+                  persistence=False, order=None):
+        """Which observations (`values` of the states named, at `times`: one per state or a single
+        one) are anomalous at `confidence` in [0.5, 1]."""
+        times = [float(times)] if isinstance(times, (int, float)) else [float(t) for t in times]
+        request = query_pb2.CheckAnomaliesRequest(
+            map=map_name, states=refs.state_refs("anomalies", ids, names, cells, points),
+            values=[float(v) for v in values], times=times, confidence=confidence,
+            options=refs.prediction_options(persistence, order))
+        response = self._call(self._query.CheckAnomalies, request, map_name)
+        return AnomalyCheck(list(response.probabilities), list(response.anomalous))
+
+    # --- admin ---
+
+    def update(self, map_name, wait=True, poll_interval=0.05):
+        """Runs the update job on the map now (order selection and republication of P) and, when
+        `wait`, waits for it to finish; returns its fremen.v1.Operation. A job that ends in error
+        raises that error."""
+        operation = self._call(self._admin.RunUpdate, admin_pb2.RunUpdateRequest(map=map_name), map_name)
+        while wait and not operation.done:
+            time_module.sleep(poll_interval)
+            operation = self._call(self._admin.GetOperation,
+                                   admin_pb2.GetOperationRequest(map=map_name, name=operation.name), map_name)
+        if operation.done and operation.error.code != 0:
+            raise errors.error_from_status(operation.error.code, operation.error.message)
+        return operation

@@ -1,0 +1,250 @@
+"""A batched ingest session over one IngestService.Ingest stream (bidirectional).
+
+Each send() puts one batch (one scan: a time and many (state, value) pairs) on the stream with the
+session's writer id and the next sequence number, and returns that number. The daemon answers every
+batch, in order, once it is durable and applied (or refused): wait() blocks until every batch sent
+so far is answered and returns the new acknowledgements; close() ends the stream and returns the
+rest.
+
+Why a reader thread: gRPC delivers answers only while someone reads them, and the daemon stops
+reading batches (flow control) while its answers pile up, so a caller that sends many batches
+before waiting would stall both sides. The reader keeps answers flowing; `max_in_flight` bounds the
+batches sent but not yet answered, so send() blocks instead of queueing without bound.
+
+A batch refused as a whole comes back as an Ack whose `error` is set (the stream goes on); a stream
+that fails (unknown map, missing token, daemon gone) makes the next send/wait/close raise the
+fremen.Error. Its unanswered() batches may then have been applied or not: a new session of the
+same writer id resend()s them, and the daemon applies each exactly once. Thread-safety: one thread sends; wait/close from that thread too.
+"""
+
+import collections
+import dataclasses
+import queue
+import threading
+import time as time_module
+
+import grpc
+
+from fremen import errors, refs
+from fremen.v1 import common_pb2, ingest_pb2
+
+_END = object()  # ends the request iterator
+
+
+@dataclasses.dataclass(frozen=True)
+class Rejection:
+    """One observation not applied: its position in the batch and why ("VALUE_OUT_OF_RANGE",
+    "OUTSIDE_MAP")."""
+    index: int
+    reason: str
+
+
+@dataclasses.dataclass(frozen=True)
+class Ack:
+    """The daemon's answer to one batch."""
+    sequence: int
+    accepted: int
+    rejected: int
+    duplicate: bool  # a retry of a batch applied before: nothing applied this time
+    rejections: list  # the first Rejection objects (at most 16)
+    error: object  # a fremen.Error when the batch was refused as a whole, else None
+
+    @property
+    def ok(self):
+        return self.error is None
+
+    @classmethod
+    def from_proto(cls, response):
+        error = None
+        if response.HasField("error") and response.error.code != 0:
+            error = errors.error_from_status(response.error.code, response.error.message)
+        rejections = [
+            Rejection(r.index, ingest_pb2.RejectReason.Name(r.reason).removeprefix("REJECT_REASON_"))
+            for r in response.rejections
+        ]
+        return cls(response.sequence, response.accepted, response.rejected, response.duplicate, rejections, error)
+
+
+class IngestSession:
+    """Made by Client.ingest(); use as a context manager or call close()."""
+
+    def __init__(self, ingest_method, map_name, metadata, writer_id, first_sequence, max_in_flight, timeout):
+        if max_in_flight < 1:
+            raise errors.InvalidArgument(f"max_in_flight must be at least 1, got {max_in_flight}")
+        self.map = map_name
+        self.writer_id = writer_id
+        # The sequence number the next send() uses unless told otherwise.
+        self.next_sequence = first_sequence
+        self._max_in_flight = max_in_flight
+        self._requests = queue.Queue()
+        self._lock = threading.Condition()
+        self._unanswered = collections.deque()  # batches sent, oldest first, not yet answered
+        self._new_acks = []
+        self._failure = None  # the fremen.Error that ended the stream
+        self._ended = False  # the daemon's side of the stream ended
+        self._closed = False
+        self._call = ingest_method(self._request_iterator(), metadata=metadata, timeout=timeout)
+        self._reader = threading.Thread(target=self._read_acks, name=f"fremen-ingest-{map_name}", daemon=True)
+        self._reader.start()
+
+    # --- sending ---
+
+    def send(self, time, values, *, ids=None, names=None, groups=None, cells=None, points=None, sequence=None):
+        """Sends one batch: observations `values` (each in [0, 1]) at `time` (seconds) of the states
+        named by exactly one of ids= / names= (generic maps; groups= optionally labels each state
+        the first time it is seen) or cells= / points= (grid maps). sequence: the batch's number
+        instead of the next one (later batches continue above it). Returns its sequence number."""
+        request = ingest_pb2.IngestRequest(map=self.map, writer_id=self.writer_id, time=time)
+        values = [float(v) for v in values]
+        kind = refs.chosen_kind({"ids": ids, "names": names, "cells": cells, "points": points}, "send")
+        if groups is not None and kind not in ("ids", "names"):
+            raise errors.InvalidArgument("groups= labels generic states (ids= or names=), not grid cells")
+        groups = list(groups) if groups is not None else []
+        if kind == "ids":
+            request.states.ids.extend(int(i) for i in ids)
+            request.states.values.extend(values)
+            request.states.groups.extend(groups)
+        elif kind == "names":
+            request.named_states.names.extend(names)
+            request.named_states.values.extend(values)
+            request.named_states.groups.extend(groups)
+        elif kind == "cells":
+            request.cells.cells.CopyFrom(refs.cell_indices(cells))
+            request.cells.values.extend(values)
+        else:
+            request.points.points.CopyFrom(refs.points(points))
+            request.points.values.extend(values)
+        return self._put(request, sequence)
+
+    def send_patch(self, time, origin, size, *, values=None, probabilities=None, sequence=None):
+        """Sends a dense box of a grid map: `origin` (x, y[, z]) its first cell, `size` (nx, ny[, nz])
+        its cells, and either `values` (floats in [0, 1], x fastest, then y, then z; a numpy array
+        of shape (nz, ny, nx) or (ny, nx) is flattened in that order) or `probabilities` (bytes, one
+        per cell, s = byte / 255). Returns its sequence number."""
+        if (values is None) == (probabilities is None):
+            raise errors.InvalidArgument("send_patch needs exactly one of values= and probabilities=")
+        request = ingest_pb2.IngestRequest(map=self.map, writer_id=self.writer_id, time=time)
+        o = list(origin) + [0] * (3 - len(origin))
+        s = list(size) + [1] * (3 - len(size))
+        request.patch.origin.CopyFrom(common_pb2.CellIndex(x=o[0], y=o[1], z=o[2]))
+        request.patch.size.CopyFrom(common_pb2.GridSize(x=s[0], y=s[1], z=s[2]))
+        if values is not None:
+            flat = values.ravel() if hasattr(values, "ravel") else values
+            request.patch.values.extend(float(v) for v in flat)
+        else:
+            request.patch.probabilities = bytes(probabilities)
+        return self._put(request, sequence)
+
+    def resend(self, batches):
+        """Sends again batches that another session of the same writer sent but never saw answered
+        (its unanswered() after the stream failed), with their own sequence numbers: the daemon
+        applies those it lacks and answers the others with duplicate=True, so that nothing is lost
+        or applied twice. Later send()s continue after the highest sequence resent."""
+        for batch in batches:
+            if batch.writer_id != self.writer_id:
+                raise errors.InvalidArgument(
+                    f"resend: batch {batch.sequence} is of writer {batch.writer_id}, this session writes as "
+                    f"{self.writer_id}: open it with ingest(..., writer_id={batch.writer_id})")
+            request = ingest_pb2.IngestRequest()
+            request.CopyFrom(batch)
+            request.map = self.map
+            self._put(request, request.sequence)
+
+    def unanswered(self):
+        """The batches (fremen.v1.IngestRequest) sent and not answered yet, oldest first: after the
+        stream failed, the ones to resend() in a new session."""
+        with self._lock:
+            return list(self._unanswered)
+
+    def _put(self, request, sequence):
+        """Numbers the batch (`sequence`, or the next one when None) and queues it for the stream;
+        blocks while max_in_flight batches are unanswered. The batch's sequence number."""
+        with self._lock:
+            if self._closed:
+                raise errors.error_for(grpc.StatusCode.FAILED_PRECONDITION, "the ingest session is closed")
+            self._lock.wait_for(lambda: self._failure or self._ended or len(self._unanswered) < self._max_in_flight)
+            self._raise_if_ended()
+            request.sequence = self.next_sequence if sequence is None else sequence
+            # Numbers only go up: a writer's batch at or below its highest applied one is a retry.
+            self.next_sequence = max(self.next_sequence, request.sequence + 1)
+            self._unanswered.append(request)
+        self._requests.put(request)
+        return request.sequence
+
+    def _request_iterator(self):
+        while (request := self._requests.get()) is not _END:
+            yield request
+
+    # --- acknowledgements ---
+
+    def _read_acks(self):
+        try:
+            for response in self._call:
+                with self._lock:
+                    self._new_acks.append(Ack.from_proto(response))
+                    self._unanswered.popleft()  # answers come in the order of the batches
+                    self._lock.notify_all()
+        except grpc.RpcError as error:
+            with self._lock:
+                self._failure = errors.error_from_rpc(error)
+        finally:
+            with self._lock:
+                self._ended = True
+                self._lock.notify_all()
+            self._requests.put(_END)  # the daemon is gone: stop the sender
+
+    def _raise_if_ended(self):
+        # Called with the lock held.
+        if self._failure is not None:
+            raise self._failure
+        if self._ended and self._unanswered:
+            raise errors.error_for(grpc.StatusCode.UNKNOWN,
+                                   f"the ingest stream ended with {len(self._unanswered)} batches unanswered")
+
+    def wait(self, timeout=None):
+        """Blocks until every batch sent so far is answered; returns the Acks that came since the
+        last wait() (in sequence order). Raises the stream's fremen.Error if it failed, and
+        DeadlineExceeded after `timeout` seconds."""
+        deadline = None if timeout is None else time_module.monotonic() + timeout
+        with self._lock:
+            while self._unanswered and not self._failure and not self._ended:
+                remaining = None if deadline is None else deadline - time_module.monotonic()
+                if remaining is not None and remaining <= 0:
+                    raise errors.error_for(
+                        grpc.StatusCode.DEADLINE_EXCEEDED,
+                        f"{len(self._unanswered)} batches still unanswered after {timeout} s")
+                self._lock.wait(remaining)
+            self._raise_if_ended()
+            acks, self._new_acks = self._new_acks, []
+            return acks
+
+    def close(self, timeout=None):
+        """Ends the stream after the batches sent, waits for their answers and the daemon's end of
+        the call; returns the Acks not yet returned by wait(). Raises the stream's fremen.Error."""
+        if not self._closed:
+            self._closed = True
+            self._requests.put(_END)
+        self._reader.join(timeout)
+        if self._reader.is_alive():
+            self._call.cancel()
+            raise errors.error_for(grpc.StatusCode.DEADLINE_EXCEEDED,
+                                  f"the ingest stream did not end within {timeout} s")
+        return self.wait()
+
+    def cancel(self):
+        """Abandons the stream: batches not yet answered may or may not have been applied (resend
+        them with the same writer id and sequence numbers to find out)."""
+        self._closed = True
+        self._call.cancel()
+        self._requests.put(_END)
+        self._reader.join()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, traceback):
+        if exc_type is None:
+            self.close()
+        else:
+            self.cancel()
+        return False
