@@ -95,21 +95,26 @@ BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector
 // label count varint | labels (key varint, name, group as length-prefixed bytes).
 std::string EncodeBatch(const ObservationBatch& batch) {
   std::string out;
-  out.reserve(32 + batch.keys.size() * 7 + batch.observation_count() * 4);
+  out.reserve(32 + batch.keys.size() * model::kMaxVarint64Bytes + batch.observation_count() * 4);
   out.push_back(static_cast<char>(kBatchVersion));
   model::PutVarint64(&out, batch.writer_id);
   model::PutVarint64(&out, batch.sequence);
   model::PutDouble(&out, batch.time);
   model::PutVarint64(&out, batch.keys.size());
+  // The keys' deltas into room for the longest varints, then cut to what they took.
+  const size_t keys_at = out.size();
+  out.resize(keys_at + batch.keys.size() * model::kMaxVarint64Bytes);
+  char* end = out.data() + keys_at;
   uint64_t previous = 0;
   for (uint64_t key : batch.keys) {
-    model::PutVarint64(&out, model::ZigZagEncode64(static_cast<int64_t>(key - previous)));
+    end = model::EncodeVarint64(end, model::ZigZagEncode64(static_cast<int64_t>(key - previous)));
     previous = key;
   }
-  for (float v : batch.values) model::PutFloat(&out, v);
+  out.resize(end - out.data());
+  model::PutFloats(&out, batch.values);
   for (uint32_t o : batch.patch.origin) model::PutVarint64(&out, o);
   for (uint32_t s : batch.patch.size) model::PutVarint64(&out, s);
-  for (float v : batch.patch.values) model::PutFloat(&out, v);
+  model::PutFloats(&out, batch.patch.values);
   model::PutVarint64(&out, batch.labels.size());
   for (const StateLabel& label : batch.labels) {
     model::PutVarint64(&out, label.key);

@@ -170,8 +170,9 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
     uint32_t d = slots_[slot].dynamic;
     if (d == kNone) {
       if (!lossless_ && slots_[slot].static_state.Accepts(values[i])) {
+        // Only a state's first observation sets its handle: later ones repeat the same value.
+        if (slots_[slot].static_state.count() == 0) SetHandle(keys[i], kStaticHandle | (values[i] == 1.0f ? 1u : 0u));
         slots_[slot].static_state.Observe(t, values[i]);
-        SetHandle(keys[i], kStaticHandle | (values[i] == 1.0f ? 1u : 0u));
         continue;
       }
       d = Promote(slot);

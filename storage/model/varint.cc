@@ -54,13 +54,7 @@ void AppendLittleEndian(std::string* out, T v) {
 
 void PutVarint64(std::string* out, uint64_t v) {
   char buf[kMaxVarint64Bytes];
-  size_t n = 0;
-  while (v >= 0x80) {
-    buf[n++] = static_cast<char>(v | 0x80);
-    v >>= 7;
-  }
-  buf[n++] = static_cast<char>(v);
-  out->append(buf, n);
+  out->append(buf, EncodeVarint64(buf, v) - buf);
 }
 
 size_t Varint64Length(uint64_t v) {
@@ -81,6 +75,13 @@ absl::StatusOr<uint64_t> GetVarint64(std::string_view* in) {
 void PutFixed32(std::string* out, uint32_t v) { AppendLittleEndian(out, v); }
 void PutFixed64(std::string* out, uint64_t v) { AppendLittleEndian(out, v); }
 void PutFloat(std::string* out, float v) { PutFixed32(out, std::bit_cast<uint32_t>(v)); }
+void PutFloats(std::string* out, std::span<const float> values) {
+  if constexpr (std::endian::native == std::endian::little) {
+    out->append(reinterpret_cast<const char*>(values.data()), values.size_bytes());
+  } else {
+    for (const float v : values) PutFloat(out, v);
+  }
+}
 void PutDouble(std::string* out, double v) { PutFixed64(out, std::bit_cast<uint64_t>(v)); }
 
 bool ByteReader::Need(size_t n, std::string_view field) {

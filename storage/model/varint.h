@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -18,7 +19,18 @@ namespace fremen::model {
 
 inline constexpr size_t kMaxVarint64Bytes = 10;
 
-// Appends the LEB128 encoding of v (7 bits per byte, low bits first, high bit = more bytes follow).
+// Writes the LEB128 encoding of v (7 bits per byte, low bits first, high bit = more bytes follow)
+// at dst, which must have room for kMaxVarint64Bytes; returns the end. Inline: encoders of long
+// arrays (a scan's keys) call it per element into a buffer sized once.
+inline char* EncodeVarint64(char* dst, uint64_t v) {
+  while (v >= 0x80) {
+    *dst++ = static_cast<char>(v | 0x80);
+    v >>= 7;
+  }
+  *dst++ = static_cast<char>(v);
+  return dst;
+}
+// Appends the LEB128 encoding of v.
 void PutVarint64(std::string* out, uint64_t v);
 // The encoded length of v in bytes (1..10).
 size_t Varint64Length(uint64_t v);
@@ -36,6 +48,8 @@ inline int64_t ZigZagDecode64(uint64_t v) { return static_cast<int64_t>(v >> 1) 
 void PutFixed32(std::string* out, uint32_t v);
 void PutFixed64(std::string* out, uint64_t v);
 void PutFloat(std::string* out, float v);
+// PutFloat of every value, in one append on a little-endian machine.
+void PutFloats(std::string* out, std::span<const float> values);
 void PutDouble(std::string* out, double v);
 
 // Reads a record front to back. Every read checks the remaining length first. The first failure is
