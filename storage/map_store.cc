@@ -58,7 +58,7 @@ absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const MapInfo& info, co
   LmdbOptions lmdb;
   lmdb.initial_map_size = options.initial_map_size;
   for (uint32_t i = 0; i < info.shards; ++i) {
-    auto shard = Shard::Open(store->info_, *store->settings_, ShardDir(dir, i), lmdb);
+    auto shard = Shard::Open(store->info_, *store->settings_, ShardDir(dir, i), lmdb, options.widen_records_at);
     if (!shard.ok()) {
       return absl::Status(shard.status().code(), absl::StrCat("map ", info.name, " shard ", i, ": ",
                                                               shard.status().message()));
@@ -523,6 +523,7 @@ MapStats MapStore::Stats() const {
     stats.totals.observations += s.observations;
     stats.totals.disk_bytes += s.disk_bytes;
     stats.totals.memory_bytes += s.memory_bytes;
+    stats.totals.wide_states += s.wide_states;
     stats.totals.prediction_error_sum += s.prediction_error_sum;
     stats.totals.prediction_error_states += s.prediction_error_states;
     stats.totals.estimation_wrong += s.estimation_wrong;

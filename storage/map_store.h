@@ -50,6 +50,9 @@ struct StoreOptions {
   uint64_t max_queued_observations = 16ull << 20;
   // Fault injection for tests (see WalOptions::inject_fault). Default: none.
   std::function<absl::Status()> inject_log_fault;
+  // Observations after which a state's float spectrum is folded in double (model/wide_bodies.h).
+  // Default: model::kCompactRecordLimit; tests lower it.
+  uint32_t widen_records_at = model::kCompactRecordLimit;
 };
 
 struct MapStats {

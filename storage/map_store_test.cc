@@ -312,3 +312,54 @@ TEST(MapStoreTest, ObservedLabelsAndPublicationProgress) {
 
 }  // namespace
 }  // namespace fremen::storage
+
+namespace fremen::storage {
+namespace {
+
+// States past the widening limit fold in double (model/wide_bodies.h); the limit is lowered from
+// 2^20 to 100 observations so that the test runs in a second.
+TEST(MapStoreTest, StatesPastTheWideningLimitFoldInDoubleAndRecoverExactly) {
+  TempDir dir, reference_dir, float_dir;
+  const MapInfo map = GridMap("m", 4, 4, 1, 2);
+  StoreOptions options;
+  options.widen_records_at = 100;
+  options.checkpoint_log_bytes = 20000;  // checkpoints along the way write the double bodies
+  auto reference = OpenOrDie(map, reference_dir.path(), options);
+  auto all_float = OpenOrDie(map, float_dir.path());  // never widens at these counts
+  auto store = OpenOrDie(map, dir.path(), options);
+  for (uint64_t i = 0; i < 240; ++i) {
+    const ObservationBatch scan = SweepScan(map, 1, i, 40);
+    ASSERT_TRUE(store->Write(scan).ok());
+    ASSERT_TRUE(reference->Write(scan).ok());
+    ASSERT_TRUE(all_float->Write(scan).ok());
+    if (i == 170) {  // a restart once the dynamic states are wide
+      EXPECT_GT(store->Stats().totals.wide_states, 0u);
+      store.reset();
+      store = OpenOrDie(map, dir.path(), options);
+    }
+  }
+  const MapStats stats = reference->Stats();
+  EXPECT_GT(stats.totals.dynamic_states, 0u);
+  EXPECT_EQ(stats.totals.wide_states, stats.totals.dynamic_states);  // each has ~600 observations
+  EXPECT_EQ(all_float->Stats().totals.wide_states, 0u);
+  // At ~600 observations float is still accurate: the double fold must agree with it closely.
+  for (uint32_t x = 0; x < 4; ++x) {
+    for (uint32_t y = 0; y < 4; ++y) {
+      const uint64_t key = map.grid.keys().Key(x, y, 0);
+      const auto wide = reference->Snapshot(key), narrow = all_float->Snapshot(key);
+      ASSERT_TRUE(wide.has_value() && narrow.has_value());
+      if (wide->is_static) continue;
+      const model::CompactSpectrum& a = wide->model->spectrum();
+      const model::CompactSpectrum& b = narrow->model->spectrum();
+      ASSERT_EQ(a.header(), b.header());
+      for (size_t r = 0; r < a.periods() * model::kRealsPerPeriod; ++r) {
+        EXPECT_NEAR(a.body()[r], b.body()[r], 1e-6) << key << " real " << r;
+      }
+    }
+  }
+  // The restarted store folded on from its checkpointed double bodies: the same bits.
+  ExpectSameModels(*store, *reference, map);
+}
+
+}  // namespace
+}  // namespace fremen::storage

@@ -17,6 +17,7 @@ namespace {
 constexpr char kStaticDb[] = "static";
 constexpr char kDynamicDb[] = "dynamic";
 constexpr char kLosslessDb[] = "lossless";
+constexpr char kWideDb[] = "wide";  // state key → double spectrum body of a wide state (WideBodies)
 constexpr char kLabelsDb[] = "labels";
 constexpr char kMetaDb[] = "meta";
 constexpr char kLsnKey[] = "checkpoint_lsn";
@@ -31,23 +32,27 @@ absl::Status WithKey(const absl::Status& s, const char* family, uint64_t key) {
 
 }  // namespace
 
-Shard::Shard(const MapInfo& map, const model::ModelSettings& settings, std::unique_ptr<LmdbEnv> env)
+Shard::Shard(const MapInfo& map, const model::ModelSettings& settings, std::unique_ptr<LmdbEnv> env,
+             uint32_t widen_records_at)
     : map_(map),
       settings_(settings),
       lossless_(map.lossless_sampling_period > 0),
       grid_keys_(map.grid.keys()),
       env_(std::move(env)),
       spectra_(settings.periods.size()),
+      wide_(settings.periods.size()),
+      widen_at_(widen_records_at),
       models_(settings.max_order),
       errors_(settings.max_order) {}
 
 absl::StatusOr<std::unique_ptr<Shard>> Shard::Open(const MapInfo& map, const model::ModelSettings& settings,
-                                                   const std::string& dir, const LmdbOptions& options) {
+                                                   const std::string& dir, const LmdbOptions& options,
+                                                   uint32_t widen_records_at) {
   LmdbOptions with_databases = options;
-  with_databases.databases = {kStaticDb, kDynamicDb, kLosslessDb, kLabelsDb, kMetaDb};
+  with_databases.databases = {kStaticDb, kDynamicDb, kLosslessDb, kWideDb, kLabelsDb, kMetaDb};
   auto env = LmdbEnv::Open(dir, with_databases);
   if (!env.ok()) return env.status();
-  auto shard = std::unique_ptr<Shard>(new Shard(map, settings, *std::move(env)));
+  auto shard = std::unique_ptr<Shard>(new Shard(map, settings, *std::move(env), widen_records_at));
   if (absl::Status loaded = shard->Load(); !loaded.ok()) return loaded;
   return shard;
 }
@@ -130,6 +135,8 @@ uint32_t Shard::Promote(uint32_t slot) {
 
 void Shard::StoreModel(uint32_t d, const model::CompactStateModel& m) {
   spectra_.Store(d, m.spectrum());
+  // A restored record past the limit is widened again from its float body (see wide_bodies.h).
+  if (spectra_.header(d).n >= widen_at_) wide_.Widen(d, spectra_.body(d));
   if (m.has_published()) {
     models_.Set(d, m.published());
   } else {
@@ -177,16 +184,40 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
       }
       d = Promote(slot);
     }
-    scan_cells_.push_back(d);
-    scan_values_.push_back(values[i]);
+    if (wide_.wide(d)) {
+      scan_wide_cells_.push_back(d);
+      scan_wide_values_.push_back(values[i]);
+    } else {
+      scan_cells_.push_back(d);
+      scan_values_.push_back(values[i]);
+    }
   }
   const model::ScanScoring scoring{&models_, &errors_, settings_.criterion, settings_.error_half_life};
   model::ScoreAndApplyScan(spectra_, scoring, scan.table, scan.phasors, scan_cells_, scan_values_);
+  ApplyWide(scan, scoring);
   for (size_t j = 0; j < scan_cells_.size(); ++j) {
-    persistence_[scan_cells_[j]].Observe(t, scan_values_[j]);
+    const uint32_t d = scan_cells_[j];
+    if (spectra_.header(d).n >= widen_at_) wide_.Widen(d, spectra_.body(d));
+    persistence_[d].Observe(t, scan_values_[j]);
     // The batch was validated against the map's lossless origin, so Add cannot fail on time.
-    if (lossless_) (void)lossless_histories_[scan_cells_[j]].Add(t, scan_values_[j]);
+    if (lossless_) (void)lossless_histories_[d].Add(t, scan_values_[j]);
   }
+}
+
+void Shard::ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring) {
+  if (scan_wide_cells_.empty()) return;
+  const double t = scan.table.time();
+  // Scored against the published P before the fold, as every observation is (prequential).
+  model::ScoreScan(scoring, scan.table, scan_wide_cells_, scan_wide_values_);
+  const model::ScanPhasors<double> phasors(scan.table);
+  for (size_t j = 0; j < scan_wide_cells_.size(); ++j) {
+    const uint32_t d = scan_wide_cells_[j];
+    wide_.Fold(d, spectra_.header(d), spectra_.body(d), phasors, scan_wide_values_[j]);
+    persistence_[d].Observe(t, scan_wide_values_[j]);
+    if (lossless_) (void)lossless_histories_[d].Add(t, scan_wide_values_[j]);
+  }
+  scan_wide_cells_.clear();
+  scan_wide_values_.clear();
 }
 
 void Shard::ApplyLabels(std::span<const StateLabel> labels) {
@@ -352,7 +383,8 @@ ShardStats Shard::Stats() const {
     stats.lossless_prediction_wrong += prediction.wrong;
     stats.lossless_prediction_observed += prediction.observed;
   }
-  stats.memory_bytes = spectra_.bytes() + models_.bytes() + errors_.bytes() +
+  stats.wide_states = wide_.size();
+  stats.memory_bytes = spectra_.bytes() + wide_.bytes() + models_.bytes() + errors_.bytes() +
                        persistence_.capacity() * sizeof(model::Persistence) +
                        slots_.capacity() * sizeof(Slot) +
                        brick_data_.capacity() * sizeof(Brick);
@@ -386,9 +418,10 @@ absl::Status Shard::Checkpoint(uint64_t lsn, const DedupTable& dedup) {
     auto static_db = txn.Db(kStaticDb);
     auto dynamic_db = txn.Db(kDynamicDb);
     auto lossless_db = txn.Db(kLosslessDb);
+    auto wide_db = txn.Db(kWideDb);
     auto labels_db = txn.Db(kLabelsDb);
     auto meta_db = txn.Db(kMetaDb);
-    for (auto* db : {&static_db, &dynamic_db, &lossless_db, &labels_db, &meta_db}) {
+    for (auto* db : {&static_db, &dynamic_db, &lossless_db, &wide_db, &labels_db, &meta_db}) {
       if (!db->ok()) return db->status();
     }
     for (uint32_t slot : dirty) {
@@ -400,6 +433,9 @@ absl::Status Shard::Checkpoint(uint64_t lsn, const DedupTable& dedup) {
       if (lossless_) {
         const std::string history = lossless_histories_[d].Encode();
         if (absl::Status s = txn.Put(*lossless_db, key, Bytes(history)); !s.ok()) return s;
+      }
+      if (wide_.wide(d)) {
+        if (absl::Status s = txn.Put(*wide_db, key, Bytes(wide_.Encode(d))); !s.ok()) return s;
       }
     }
     // A brick's never-changed states are written together; a brick left with none is deleted.
@@ -504,6 +540,15 @@ absl::Status Shard::Load() {
           }
           lossless_histories_[slots_[slot].dynamic] = *std::move(decoded);
           return absl::OkStatus();
+        });
+        !s.ok()) {
+      return s;
+    }
+    // After the float records: a wide state's exact double body replaces the one widened from them.
+    if (absl::Status s = scan(kWideDb, [&](uint64_t key, std::string_view value) -> absl::Status {
+          const uint32_t slot = FindSlot(key);
+          if (slot == kNone || slots_[slot].dynamic == kNone) return absl::DataLossError("a wide body without its state");
+          return wide_.Decode(slots_[slot].dynamic, value);
         });
         !s.ok()) {
       return s;

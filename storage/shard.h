@@ -12,6 +12,7 @@
 //   static    brick key → version, 64-byte presence bitmap, 16 bytes per present never-changed state
 //   dynamic   state key → EncodeStateModel<float> (spectrum, P, persistence, order errors)
 //   lossless  state key → LosslessHistory record (lossless maps)
+//   wide      state key → the double spectrum body of a state past 2^20 observations (WideBodies)
 //   labels    state key → name and group (generic maps)
 //   meta      "checkpoint_lsn" → the last log record the checkpoint covers; "dedup" → DedupTable
 // Keys are big-endian so that LMDB's order is key order (Morton order for grids).
@@ -42,8 +43,10 @@
 #include "storage/model/order_error_table.h"
 #include "storage/model/persistence.h"
 #include "storage/model/record_arena.h"
+#include "storage/model/scan_update.h"
 #include "storage/model/state_model.h"
 #include "storage/model/static_state.h"
+#include "storage/model/wide_bodies.h"
 
 namespace fremen::storage {
 
@@ -81,6 +84,7 @@ struct ShardStats {
   uint64_t observations = 0;  // Σ n over states
   uint64_t disk_bytes = 0;
   uint64_t memory_bytes = 0;
+  uint64_t wide_states = 0;  // dynamic states whose spectrum is folded in double (model/wide_bodies.h)
   std::vector<uint64_t> order_histogram;  // selected order of dynamic published states, 0..L
   double prediction_error_sum = 0;        // Σ ε_p(selected order) over dynamic states with evidence
   uint64_t prediction_error_states = 0;
@@ -96,8 +100,11 @@ inline constexpr float kUnobservedProbability = 0.5f;
 class Shard {
  public:
   // Opens (creating when missing) the shard's environment and loads every state into memory.
+  // `widen_records_at`: the observation count at which a dynamic state's float spectrum is widened
+  // to double (model/wide_bodies.h); tests lower it.
   static absl::StatusOr<std::unique_ptr<Shard>> Open(const MapInfo& map, const model::ModelSettings& settings,
-                                                     const std::string& dir, const LmdbOptions& options);
+                                                     const std::string& dir, const LmdbOptions& options,
+                                                     uint32_t widen_records_at = model::kCompactRecordLimit);
 
   // --- writer side ---
   // Folds accepted observations (keys of this shard, values in [0, 1]) taken at the scan's time.
@@ -134,7 +141,8 @@ class Shard {
   LmdbEnv& env() { return *env_; }
 
  private:
-  Shard(const MapInfo& map, const model::ModelSettings& settings, std::unique_ptr<LmdbEnv> env);
+  Shard(const MapInfo& map, const model::ModelSettings& settings, std::unique_ptr<LmdbEnv> env,
+        uint32_t widen_records_at);
 
   static constexpr uint32_t kNone = UINT32_MAX;
   // A handle says what predicting a cell needs without touching its slot: kNone (unobserved),
@@ -158,6 +166,8 @@ class Shard {
   uint32_t ReserveSlot(uint64_t key);
   void SetHandle(uint64_t key, uint32_t handle) { BrickFor(key).handles[key & 511] = handle; }
   uint32_t Promote(uint32_t slot);  // static → dynamic; returns the dynamic index
+  // Apply's second part: scores and folds the scan's observations of wide states (scan_wide_*).
+  void ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring);
   uint32_t AddDynamic(uint32_t slot);
   void MarkDirty(uint32_t slot);
   float PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f, const float* sin_f,
@@ -192,6 +202,9 @@ class Shard {
   // Per dynamic state.
   std::vector<uint32_t> slot_of_;
   model::RecordArena spectra_;
+  // Double bodies of the spectra with more observations than float keeps accurately.
+  model::WideBodies wide_;
+  const uint32_t widen_at_;
   model::CompactModels models_;
   model::OrderErrorTable errors_;
   std::vector<model::Persistence> persistence_;
@@ -203,6 +216,8 @@ class Shard {
   std::vector<uint32_t> scan_slots_;
   std::vector<uint32_t> scan_cells_;
   std::vector<float> scan_values_;
+  std::vector<uint32_t> scan_wide_cells_;
+  std::vector<float> scan_wide_values_;
 
   uint64_t checkpoint_lsn_ = 0;
   DedupTable checkpoint_dedup_;
