@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +22,7 @@ constexpr char kBatchRecord = 'B';    // an ObservationBatch follows
 constexpr char kPublishRecord = 'P';  // every shard republished its models here
 
 std::string ShardDir(const std::string& dir, uint32_t i) { return absl::StrCat(dir, "/shard-", i); }
+std::string LastUpdatePath(const std::string& dir) { return dir + "/last_update"; }
 
 absl::Status MakeDir(const std::string& dir) {
   if (mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) {
@@ -68,6 +70,8 @@ absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const MapInfo& info, co
   if (absl::Status s = store->Recover(); !s.ok()) {
     return absl::Status(s.code(), absl::StrCat("map ", info.name, ": recovery: ", s.message()));
   }
+  // Only a report: an unreadable record is shown as none rather than keeping the map closed.
+  if (auto last = ReadUpdateRecord(LastUpdatePath(dir)); last.ok()) store->last_update_ = *std::move(last);
   store->workers_ = std::make_unique<ShardWorkers>(info.shards, "fremen-shard");
   store->committer_ = std::thread([s = store.get()] { s->CommitLoop(); });
   store->applier_ = std::thread([s = store.get()] { s->ApplyLoop(); });
@@ -241,6 +245,13 @@ absl::StatusOr<uint64_t> MapStore::PublishModels(std::function<void(uint64_t, ui
   return RunControl(Control::Kind::kPublish, std::move(progress));
 }
 
+absl::Status MapStore::RecordUpdate(const UpdateRecord& record) {
+  std::lock_guard lock(last_update_mutex_);
+  if (absl::Status s = WriteUpdateRecord(LastUpdatePath(dir_), record); !s.ok()) return s;
+  last_update_ = record;
+  return absl::OkStatus();
+}
+
 absl::Status MapStore::Close() {
   {
     std::lock_guard lock(queue_mutex_);
@@ -342,6 +353,12 @@ void MapStore::ApplyLoop() {
     Stage stage;
     {
       std::unique_lock lock(stage_mutex_);
+      if (publication_.has_value() && stages_.empty()) {
+        // Publish a slice, then look for batches again: they wait at most one slice.
+        lock.unlock();
+        ContinuePublication();
+        continue;
+      }
       stage_changed_.wait(lock, [&] { return !stages_.empty(); });
       stage = std::move(stages_.front());
       stages_.pop_front();
@@ -349,20 +366,22 @@ void MapStore::ApplyLoop() {
     stage_changed_.notify_all();
     ApplyGroup(stage.group);
     applied_lsn_ = std::max(applied_lsn_, stage.group_lsn);
-    bool checkpoint_asked = false;
     for (Control& c : stage.controls) {
       if (c.kind == Control::Kind::kPublish) {
-        c.done(DoPublish(c.progress));
         applied_lsn_ = c.lsn;
+        StartPublication(std::move(c));
       } else {
-        checkpoint_asked = true;
+        waiting_checkpoints_.push_back(std::move(c));
       }
     }
-    if (checkpoint_asked || wal_->bytes() >= options_.checkpoint_log_bytes || stage.final) {
+    if (stage.final) FinishPublication();
+    // A checkpoint waits for the publication in progress: taken halfway, it would record states
+    // published after the publication's log record as if that record had not been applied.
+    if (!publication_.has_value() &&
+        (!waiting_checkpoints_.empty() || wal_->bytes() >= options_.checkpoint_log_bytes || stage.final)) {
       const absl::Status status = DoCheckpoint(applied_lsn_);
-      for (Control& c : stage.controls) {
-        if (c.kind == Control::Kind::kCheckpoint) c.done(status.ok() ? absl::StatusOr<uint64_t>(0) : status);
-      }
+      for (Control& c : waiting_checkpoints_) c.done(status.ok() ? absl::StatusOr<uint64_t>(0) : status);
+      waiting_checkpoints_.clear();
     }
     if (stage.final) return;
   }
@@ -407,27 +426,34 @@ void MapStore::IndexLabels(std::span<const StateLabel> labels) {
   }
 }
 
-absl::StatusOr<uint64_t> MapStore::DoPublish(const std::function<void(uint64_t, uint64_t)>& progress) {
+void MapStore::StartPublication(Control control) {
   // The committer has logged and synced the publication's record already.
-  std::vector<uint64_t> published(shards_.size());
-  std::vector<uint64_t> done(shards_.size());  // guarded by progress_mutex
-  uint64_t total = 0;
-  for (const auto& shard : shards_) total += shard->Stats().dynamic_states;
-  std::mutex progress_mutex;  // progress is reported from every shard's thread
-  workers_->RunOnAll([&](uint32_t s) {
-    published[s] = shards_[s]->PublishAll([&](uint64_t shard_done) {
-      if (!progress) return;
-      // Summed under the lock, so that reports from the shards' threads never go backwards.
-      std::lock_guard lock(progress_mutex);
-      done[s] = shard_done;
-      uint64_t all = 0;
-      for (const uint64_t d : done) all += d;
-      progress(all, total);
-    });
-  });
-  uint64_t count = 0;
-  for (uint64_t n : published) count += n;
-  return count;
+  FinishPublication();
+  std::vector<uint64_t> marked(shards_.size());
+  workers_->RunOnAll([&](uint32_t s) { marked[s] = shards_[s]->BeginPublication(); });
+  publication_total_ = 0;
+  for (uint64_t n : marked) publication_total_ += n;
+  publication_ = std::move(control);
+  if (publication_->progress) publication_->progress(0, publication_total_);
+  if (publication_total_ == 0) FinishPublication();
+}
+
+void MapStore::ContinuePublication() {
+  // A slice bounds how long a batch that arrives meanwhile waits to be applied and acknowledged.
+  constexpr auto kSlice = std::chrono::milliseconds(20);
+  std::vector<uint8_t> finished(shards_.size());
+  workers_->RunOnAll([&](uint32_t s) { finished[s] = shards_[s]->ContinuePublication(kSlice); });
+  uint64_t done = 0;
+  for (const auto& shard : shards_) done += shard->publication_done();
+  if (publication_->progress) publication_->progress(done, publication_total_);
+  if (std::all_of(finished.begin(), finished.end(), [](uint8_t f) { return f != 0; })) {
+    publication_->done(publication_total_);
+    publication_.reset();
+  }
+}
+
+void MapStore::FinishPublication() {
+  while (publication_.has_value()) ContinuePublication();
 }
 
 absl::Status MapStore::DoCheckpoint(uint64_t lsn) {
@@ -549,6 +575,10 @@ MapStats MapStore::Stats() const {
   }
   if (stats.totals.prediction_error_states > 0) {
     stats.mean_prediction_error = stats.totals.prediction_error_sum / stats.totals.prediction_error_states;
+  }
+  {
+    std::lock_guard lock(last_update_mutex_);
+    stats.last_update = last_update_;
   }
   return stats;
 }

@@ -19,6 +19,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -31,6 +32,7 @@
 #include "storage/map_info.h"
 #include "storage/shard.h"
 #include "storage/shard_workers.h"
+#include "storage/update_record.h"
 #include "storage/wal/wal.h"
 
 namespace fremen::storage {
@@ -66,6 +68,8 @@ struct MapStats {
   // Lossless maps: ε_e and ε_p over all observed slots of all states (eq. 15).
   double estimation_error = 0;
   double lossless_prediction_error = 0;
+  // What the last update job did, kept across restarts (RecordUpdate); nullopt before the first.
+  std::optional<UpdateRecord> last_update;
 };
 
 class MapStore {
@@ -91,10 +95,14 @@ class MapStore {
   void OnRoom(uint64_t observations, std::function<void()> f);
   // Checkpoints now and waits.
   absl::Status Checkpoint();
-  // Republishes every dynamic state's P with its best order (the update job's core), logged so that
-  // recovery repeats it at the same point among the batches. Waits; returns states published.
-  // `progress(done, total)` is called from time to time while the shards publish.
+  // The update job's core (Shard::BeginPublication): republishes P, with its best order, of every
+  // dynamic state observed since its last publication; logged so that recovery repeats it at the
+  // same point among the batches. It is served a slice at a time between the batches that arrive
+  // meanwhile, which are acknowledged as usual; checkpoints wait for it. Waits; returns the states
+  // published. `progress(done, total)` is called from time to time while the shards publish.
   absl::StatusOr<uint64_t> PublishModels(std::function<void(uint64_t, uint64_t)> progress = nullptr);
+  // Keeps what an update job did, for Stats(), in <dir>/last_update (replaced atomically).
+  absl::Status RecordUpdate(const UpdateRecord& record);
   // Stops accepting writes, finishes the queued ones and checkpoints. Idempotent.
   absl::Status Close();
   // OK, or the error that stopped all writes to the map (a failed log sync, commit or checkpoint:
@@ -157,7 +165,11 @@ class MapStore {
   void ApplyLoop();
   void ApplyGroup(std::vector<Pending>& group);
   absl::Status DoCheckpoint(uint64_t lsn);
-  absl::StatusOr<uint64_t> DoPublish(const std::function<void(uint64_t, uint64_t)>& progress);
+  // The applier's publication in progress (see PublishModels): Start marks the states (finishing
+  // one still in progress first), Continue publishes a slice, Finish the rest.
+  void StartPublication(Control control);
+  void ContinuePublication();
+  void FinishPublication();
   absl::StatusOr<uint64_t> RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress = nullptr);
   // Splits the accepted observations of a batch by shard.
   void SplitByShard(Pending& pending) const;
@@ -182,6 +194,9 @@ class MapStore {
   DedupTable dedup_;          // committer only: what was logged
   DedupTable applied_dedup_;  // applier only: what was applied, recorded by checkpoints
   uint64_t applied_lsn_ = 0;  // applier only
+  std::optional<Control> publication_;     // applier only: the publication in progress
+  uint64_t publication_total_ = 0;         // applier only: its states
+  std::vector<Control> waiting_checkpoints_;  // applier only: checkpoints asked during a publication
 
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_ready_;
@@ -193,6 +208,9 @@ class MapStore {
   absl::Status write_error_;  // latched: a failed log sync or checkpoint stops all writes
 
   std::mutex backup_mutex_;  // held by checkpoints and backups: a backup sees one checkpoint
+
+  mutable std::mutex last_update_mutex_;
+  std::optional<UpdateRecord> last_update_;
 
   mutable std::mutex groups_mutex_;
   absl::flat_hash_map<std::string, std::vector<uint64_t>> groups_;

@@ -22,6 +22,7 @@ constexpr char kLabelsDb[] = "labels";
 constexpr char kMetaDb[] = "meta";
 constexpr char kLsnKey[] = "checkpoint_lsn";
 constexpr char kDedupKey[] = "dedup";
+constexpr char kTouchedKey[] = "touched";
 
 std::span<const uint8_t> Bytes(std::string_view s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
 std::string_view View(std::span<const uint8_t> b) { return {reinterpret_cast<const char*>(b.data()), b.size()}; }
@@ -43,7 +44,9 @@ Shard::Shard(const MapInfo& map, const model::ModelSettings& settings, std::uniq
       wide_(settings.periods.size()),
       widen_at_(widen_records_at),
       models_(settings.max_order),
-      errors_(settings.max_order) {}
+      errors_(settings.max_order),
+      publisher_(settings.periods, settings.max_order),
+      publish_scratch_(settings.periods.size()) {}
 
 absl::StatusOr<std::unique_ptr<Shard>> Shard::Open(const MapInfo& map, const model::ModelSettings& settings,
                                                    const std::string& dir, const LmdbOptions& options,
@@ -115,6 +118,7 @@ uint32_t Shard::AddDynamic(uint32_t slot) {
   models_.Resize(d + 1);
   errors_.Resize(d + 1);
   persistence_.emplace_back();
+  publish_flags_.push_back(kTouched);
   if (lossless_) {
     lossless_histories_.push_back(*model::LosslessHistory::Create(map_.lossless_origin, map_.lossless_sampling_period));
   }
@@ -183,6 +187,10 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
         continue;
       }
       d = Promote(slot);
+    } else {
+      // A state the publication in progress has not reached: publish it as it was first.
+      if (publish_flags_[d] & kPending) PublishState(d);
+      publish_flags_[d] |= kTouched;
     }
     if (wide_.wide(d)) {
       scan_wide_cells_.push_back(d);
@@ -226,27 +234,6 @@ void Shard::ApplyLabels(std::span<const StateLabel> labels) {
     labels_[label.key] = {label.name, label.group};
     dirty_labels_.push_back(label.key);
   }
-}
-
-size_t Shard::PublishAll(const std::function<void(uint64_t)>& progress) {
-  // In blocks, each under the lock: readers see the old or the new model of a state, never a
-  // torn one, and are not held off for the whole job.
-  constexpr size_t kBlock = 1 << 16;
-  const model::Publisher publisher(settings_.periods, settings_.max_order);
-  const size_t count = slot_of_.size();
-  for (size_t first = 0; first < count; first += kBlock) {
-    const size_t n = std::min(kBlock, count - first);
-    {
-      std::unique_lock lock(mutex_);
-      publisher.PublishRange(spectra_, errors_, first, n, models_);
-      for (size_t d = first; d < first + n; ++d) {
-        if (settings_.error_half_life == 0) errors_.Reset(d);  // "only since the last update"
-        MarkDirty(slot_of_[d]);
-      }
-    }
-    if (progress) progress(first + n);
-  }
-  return count;
 }
 
 float Shard::PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f,
@@ -462,6 +449,7 @@ absl::Status Shard::Checkpoint(uint64_t lsn, const DedupTable& dedup) {
     uint8_t lsn_bytes[8];
     std::memcpy(lsn_bytes, &lsn, 8);
     if (absl::Status s = txn.Put(*meta_db, Bytes(kLsnKey), lsn_bytes); !s.ok()) return s;
+    if (absl::Status s = txn.Put(*meta_db, Bytes(kTouchedKey), Bytes(EncodeTouched())); !s.ok()) return s;
     return txn.Put(*meta_db, Bytes(kDedupKey), Bytes(dedup.Encode()));
   });
   if (!written.ok()) return written;
@@ -489,6 +477,9 @@ absl::Status Shard::Load() {
       if (!table.ok()) return table.status();
       checkpoint_dedup_ = *std::move(table);
     }
+    // Read now, applied once the dynamic states are loaded (a store without it: all touched).
+    std::optional<std::string> touched;
+    if (auto t = txn.Get(*meta_db, Bytes(kTouchedKey)); t.ok()) touched = std::string(View(*t));
     absl::Status failure;
     const auto scan = [&](const char* family, const std::function<absl::Status(uint64_t, std::string_view)>& f) {
       auto db = txn.Db(family);
@@ -552,6 +543,9 @@ absl::Status Shard::Load() {
         });
         !s.ok()) {
       return s;
+    }
+    if (touched) {
+      if (absl::Status s = DecodeTouched(*touched); !s.ok()) return s;
     }
     return scan(kLabelsDb, [&](uint64_t key, std::string_view value) -> absl::Status {
       model::ByteReader r(value, "labels");

@@ -14,7 +14,8 @@
 //   lossless  state key → LosslessHistory record (lossless maps)
 //   wide      state key → the double spectrum body of a state past 2^20 observations (WideBodies)
 //   labels    state key → name and group (generic maps)
-//   meta      "checkpoint_lsn" → the last log record the checkpoint covers; "dedup" → DedupTable
+//   meta      "checkpoint_lsn" → the last log record the checkpoint covers; "dedup" → DedupTable;
+//             "touched" → the dynamic states observed since their last publication (delta varints)
 // Keys are big-endian so that LMDB's order is key order (Morton order for grids).
 //
 // Thread-safety: Apply*, Checkpoint and Publish are called by one writer (the map's committer,
@@ -23,6 +24,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <functional>
 #include <cstdint>
 #include <memory>
@@ -42,6 +44,7 @@
 #include "storage/model/lossless_history.h"
 #include "storage/model/order_error_table.h"
 #include "storage/model/persistence.h"
+#include "storage/model/publication.h"
 #include "storage/model/record_arena.h"
 #include "storage/model/scan_update.h"
 #include "storage/model/state_model.h"
@@ -110,8 +113,26 @@ class Shard {
   // Folds accepted observations (keys of this shard, values in [0, 1]) taken at the scan's time.
   void Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::span<const float> values);
   void ApplyLabels(std::span<const StateLabel> labels);
-  // The update of §IV-B for every dynamic state: choose the order with the lowest decayed error and
-  // republish P from the spectrum (SPEC §2.4). Returns how many states were published.
+  // --- the update of §IV-B (storage/shard_publication.cc) ---
+  // A publication updates every dynamic state touched (observed) since its own last publication:
+  // choose the order with the lowest decayed error and republish P from the spectrum (SPEC §2.4);
+  // on lossless maps also reconstruct, re-transform, re-select and rebuild O (SPEC §2.5). A state
+  // not touched since is left as it is, so a second run without new data changes nothing.
+  //
+  // It runs in slices between batches: BeginPublication marks the touched states pending, each
+  // ContinuePublication publishes some of them, and a batch that observes a pending state publishes
+  // it first (in Apply) — so every state is published as it was at BeginPublication, exactly what
+  // replaying the publication's log record before the later batches gives.
+  //
+  // Marks the touched states pending; returns how many. A publication still in progress is
+  // finished first.
+  size_t BeginPublication();
+  // Publishes pending states for about `budget` (at least one block); true when none is left.
+  bool ContinuePublication(std::chrono::nanoseconds budget);
+  // Pending states handled so far by the current (or last) publication, and their total.
+  uint64_t publication_done() const { return publication_cursor_; }
+  uint64_t publication_total() const { return publication_list_.size(); }
+  // A whole publication at once (recovery's replay, tests); returns the states published.
   // `progress(states done)` is called after every block of states.
   size_t PublishAll(const std::function<void(uint64_t)>& progress = nullptr);
   // Writes every state changed since the last checkpoint, the dedup table and `lsn` in one durable
@@ -172,6 +193,13 @@ class Shard {
   void MarkDirty(uint32_t slot);
   float PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f, const float* sin_f,
                       const PredictOptions& options) const;
+  // Publishes one dynamic state (see BeginPublication) and clears its flags; `history_updated`:
+  // the caller has updated its lossless history already (outside the lock). REQUIRES: mutex_ held
+  // exclusively.
+  void PublishState(uint32_t dynamic, bool history_updated = false);
+  // The touched states' keys for the checkpoint (delta varints, in key order), and back.
+  std::string EncodeTouched() const;
+  absl::Status DecodeTouched(std::string_view bytes);
   model::CompactStateModel ModelOf(uint32_t dynamic) const;
   void StoreModel(uint32_t dynamic, const model::CompactStateModel& model);
   absl::Status Load();
@@ -209,6 +237,15 @@ class Shard {
   model::OrderErrorTable errors_;
   std::vector<model::Persistence> persistence_;
   std::vector<model::LosslessHistory> lossless_histories_;
+  // Per dynamic state: kTouched (observed since its last publication; checkpointed as the meta
+  // record "touched") and kPending (awaiting the publication in progress). Writer only.
+  static constexpr uint8_t kTouched = 1, kPending = 2;
+  std::vector<uint8_t> publish_flags_;
+  // The publication in progress: the states it marked pending and how far it has got. Writer only.
+  std::vector<uint32_t> publication_list_;
+  size_t publication_cursor_ = 0;
+  model::Publisher publisher_;
+  model::CompactSpectrum publish_scratch_;
   // Generic maps' labels.
   absl::flat_hash_map<uint64_t, std::pair<std::string, std::string>> labels_;
   std::vector<uint64_t> dirty_labels_;
