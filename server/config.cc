@@ -142,6 +142,45 @@ ConfigField BoolField(absl::string_view key, absl::string_view help, bool Server
           [member](const ServerConfig& config) { return std::string(config.*member ? "true" : "false"); }};
 }
 
+// update_map_schedules: "MAP=CRON; MAP=never; ..." (blank entries ignored). Each map once; a
+// schedule that does not parse is named by its map.
+absl::Status SetMapSchedules(absl::string_view value, ServerConfig& config) {
+  std::vector<MapSchedule> schedules;
+  for (absl::string_view entry : absl::StrSplit(value, ';')) {
+    entry = absl::StripAsciiWhitespace(entry);
+    if (entry.empty()) continue;
+    const size_t equals = entry.find('=');
+    if (equals == absl::string_view::npos) {
+      return Invalid(absl::StrCat(Quoted(entry), " is not MAP=CRON or MAP=never"));
+    }
+    MapSchedule schedule{std::string(absl::StripAsciiWhitespace(entry.substr(0, equals))),
+                         std::string(absl::StripAsciiWhitespace(entry.substr(equals + 1)))};
+    if (schedule.map.empty()) return Invalid(absl::StrCat(Quoted(entry), " names no map before '='"));
+    if (schedule.schedule == "never") schedule.schedule.clear();
+    if (!schedule.schedule.empty()) {
+      if (auto parsed = CronSchedule::Parse(schedule.schedule); !parsed.ok()) {
+        return Invalid(absl::StrCat("map ", Quoted(schedule.map), ": ", parsed.status().message()));
+      }
+    }
+    for (const MapSchedule& earlier : schedules) {
+      if (earlier.map == schedule.map) {
+        return Invalid(absl::StrCat("map ", Quoted(schedule.map), " is given twice; give each map one schedule"));
+      }
+    }
+    schedules.push_back(std::move(schedule));
+  }
+  config.update_map_schedules = std::move(schedules);
+  return absl::OkStatus();
+}
+
+std::string MapSchedulesValue(const ServerConfig& config) {
+  std::vector<std::string> entries;
+  for (const MapSchedule& s : config.update_map_schedules) {
+    entries.push_back(absl::StrCat(s.map, "=", s.schedule.empty() ? "never" : s.schedule));
+  }
+  return absl::StrJoin(entries, "; ");
+}
+
 std::vector<ConfigField> MakeConfigFields() {
   using C = ServerConfig;
   const auto non_empty = [](absl::string_view value) {
@@ -194,6 +233,8 @@ std::vector<ConfigField> MakeConfigFields() {
                     if (value == "local" || absl::LoadTimeZone(std::string(value), &zone)) return absl::OkStatus();
                     return Invalid(absl::StrCat("unknown time zone ", Quoted(value)));
                   }),
+      {"update_map_schedules", "per-map update schedules overriding update_schedule: MAP=CRON; MAP=never",
+       "SCHEDULES", SetMapSchedules, MapSchedulesValue},
       StringField("log_level", "LEVEL", "trace, debug, info, warn, error, critical or off", &C::log_level,
                   [](absl::string_view value) -> absl::Status {
                     for (const char* level : kLogLevels) {

@@ -32,6 +32,14 @@ struct TokenGrant {
   bool operator==(const TokenGrant&) const = default;
 };
 
+// One map's own update schedule (update_map_schedules): a cron expression, or "" for none (the
+// map is updated on demand only).
+struct MapSchedule {
+  std::string map;
+  std::string schedule;
+  bool operator==(const MapSchedule&) const = default;
+};
+
 struct ServerConfig {
   // HOST:PORT to serve gRPC on; IPv6 hosts in brackets ("[::1]:50051"); port 0 = any free port
   // (the chosen one is logged). Default: loopback only — exposing the daemon is a decision.
@@ -75,6 +83,9 @@ struct ServerConfig {
   // deployments that trigger it from an external cron). Default: daily at midnight local time.
   std::string update_schedule = "0 0 * * *";
   std::string update_time_zone = "local";
+  // Per-map overrides of update_schedule (same time zone), as "MAP=CRON; MAP=never; ...": those maps
+  // follow their own schedule, or none. Default: none.
+  std::vector<MapSchedule> update_map_schedules;
   // trace, debug, info, warn, error, critical or off.
   std::string log_level = "info";
 

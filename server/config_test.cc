@@ -117,6 +117,28 @@ TEST(ConfigTest, BadValuesAreNamedWithWhereTheyCameFrom) {
   EXPECT_THAT(ErrorOf("tokens = read:"), HasSubstr("a read token must be 1 or more of"));
 }
 
+TEST(ConfigTest, PerMapUpdateSchedules) {
+  ServerConfig config;
+  const absl::Status status =
+      ApplyConfigText("update_map_schedules = \"lab = 30 2 * * *; yard=never;; hall=\"\n", "test.conf", config);
+  ASSERT_TRUE(status.ok()) << status;
+  EXPECT_THAT(config.update_map_schedules,
+              ::testing::ElementsAre(MapSchedule{"lab", "30 2 * * *"}, MapSchedule{"yard", ""}, MapSchedule{"hall", ""}));
+  // Written back as the file would spell it.
+  for (const ConfigField& field : ConfigFields()) {
+    if (field.key == "update_map_schedules") {
+      EXPECT_EQ(field.get(config), "lab=30 2 * * *; yard=never; hall=never");
+    }
+  }
+  EXPECT_THAT(ErrorOf("update_map_schedules = lab"),
+              HasSubstr("config: update_map_schedules: \"lab\" is not MAP=CRON or MAP=never (test.conf line 1)"));
+  EXPECT_THAT(ErrorOf("update_map_schedules = =0 0 * * *"), HasSubstr("names no map before '='"));
+  EXPECT_THAT(ErrorOf("update_map_schedules = lab=0 24 * * *"),
+              HasSubstr("config: update_map_schedules: map \"lab\": hour: 24 is outside"));
+  EXPECT_THAT(ErrorOf("update_map_schedules = lab=never; lab=0 1 * * *"),
+              HasSubstr("config: update_map_schedules: map \"lab\" is given twice"));
+}
+
 TEST(ConfigTest, MalformedFilesAreNamedByLine) {
   EXPECT_THAT(ErrorOf("listen"), HasSubstr("config: expected key = value, got \"listen\" (test.conf line 1)"));
   EXPECT_THAT(ErrorOf("# x\nlisten_on = 1.2.3.4:5"),

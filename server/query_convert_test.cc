@@ -131,6 +131,18 @@ TEST(QueryConvertTest, MapStats) {
   EXPECT_EQ(out.mean_prediction_error(), 0.25);
   EXPECT_EQ(out.lossless_estimation_error(), 0.01);
   EXPECT_EQ(out.lossless_prediction_error(), 0.02);
+  EXPECT_FALSE(out.has_last_update()) << "no update yet";
+
+  stats.last_update = storage::UpdateRecord{1.7e9 + 0.5, 0.61, 3, 0.3, 0.2, {1, 0, 2}};
+  MapStatsToProto(stats, out);
+  ASSERT_TRUE(out.has_last_update());
+  EXPECT_EQ(out.last_update().start_time().seconds(), 1'700'000'000);
+  EXPECT_EQ(out.last_update().start_time().nanos(), 500'000'000);
+  EXPECT_EQ(out.last_update().duration_seconds(), 0.61);
+  EXPECT_EQ(out.last_update().states_updated(), 3u);
+  EXPECT_EQ(out.last_update().prediction_error_before(), 0.3);
+  EXPECT_EQ(out.last_update().prediction_error_after(), 0.2);
+  EXPECT_THAT(out.last_update().order_histogram(), ::testing::ElementsAre(1u, 0u, 2u));
 }
 
 }  // namespace

@@ -3,10 +3,20 @@
 #include <spdlog/spdlog.h>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "server/logging.h"
 #include "server/map_list.h"
 
 namespace fremen::server {
+
+namespace {
+
+spdlog::logger* Log() {
+  auto log = spdlog::get(kDaemonLogger);
+  return log != nullptr ? log.get() : spdlog::default_logger_raw();
+}
+
+}  // namespace
 
 UpdateJob StoreUpdateJob(const StoreHandle* store) {
   return [store](JobControl& control) -> absl::StatusOr<UpdateFigures> {
@@ -14,6 +24,7 @@ UpdateJob StoreUpdateJob(const StoreHandle* store) {
     if (!opened.ok()) return opened.status();
     auto map = (*opened)->Map(control.map());
     if (!map.ok()) return map.status();  // deleted since the operation was queued
+    const absl::Time start = absl::Now();
     const storage::MapStats before = (*map)->Stats();
     control.Progress(0, before.totals.dynamic_states);
     if (!control.BeginPublishing()) return absl::CancelledError("cancelled before it published");
@@ -28,6 +39,17 @@ UpdateJob StoreUpdateJob(const StoreHandle* store) {
     figures.order_histogram = after.totals.order_histogram;
     figures.prediction_error_before = before.mean_prediction_error;
     figures.prediction_error_after = after.mean_prediction_error;
+    // The map's own record, for its statistics across restarts: losing it loses only a report.
+    const storage::UpdateRecord record{absl::ToDoubleSeconds(start - absl::UnixEpoch()),
+                                       absl::ToDoubleSeconds(absl::Now() - start),
+                                       figures.states_published,
+                                       figures.prediction_error_before,
+                                       figures.prediction_error_after,
+                                       figures.order_histogram};
+    if (absl::Status kept = (*map)->RecordUpdate(record); !kept.ok()) {
+      Log()->warn("update of map {}: its record for map statistics was not kept: {}", control.map(),
+                  std::string(kept.message()));
+    }
     return figures;
   };
 }
@@ -50,9 +72,7 @@ absl::StatusOr<std::unique_ptr<UpdateScheduler>> NewStoreUpdateScheduler(const S
   auto trigger = [operations](const std::string& map) {
     // A map whose update still runs keeps that one (StartUpdate answers it): not an error.
     if (auto op = operations->StartUpdate(map, "schedule"); !op.ok()) {
-      auto log = spdlog::get(kDaemonLogger);
-      (log != nullptr ? log : spdlog::default_logger())
-          ->warn("scheduled update of map {} not started: {}", map, std::string(op.status().message()));
+      Log()->warn("scheduled update of map {} not started: {}", map, std::string(op.status().message()));
     }
   };
   return std::make_unique<UpdateScheduler>(*std::move(options), clock, std::move(list_maps), std::move(trigger));

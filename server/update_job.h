@@ -1,9 +1,11 @@
 // The update job over the store, and the daemon's update machinery built from it.
 //
 // The job of one map (§IV-B, SPEC §2.4): the map's statistics before, the publication — every
-// dynamic state's order chosen by its decayed prequential error and its P republished, one record
+// dynamic state observed since its last update has its order chosen by its decayed prequential error
+// and its P republished (lossless maps: its history re-transformed, O rebuilt), one record
 // of the map's log so that recovery repeats it (storage::MapStore::PublishModels) — and the
-// statistics after, which give the operation's figures (ε_p before/after, order histogram).
+// statistics after, which give the operation's figures (ε_p before/after, order histogram), also
+// kept as the map's UpdateRecord (storage::MapStore::RecordUpdate) for its statistics.
 // The schedule: an UpdateScheduler over every map of the store that starts operations.
 // Thread-safety: a job runs on the operation registry's thread; it only reads `store`.
 #pragma once

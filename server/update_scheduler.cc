@@ -122,6 +122,16 @@ absl::StatusOr<UpdateScheduler::Options> SchedulerOptionsFromConfig(const Server
   } else if (!absl::LoadTimeZone(config.update_time_zone, &options.zone)) {
     return absl::InvalidArgumentError(absl::StrCat("update_time_zone: unknown time zone \"", config.update_time_zone, "\""));
   }
+  for (const MapSchedule& map : config.update_map_schedules) {
+    std::optional<CronSchedule>& entry = options.overrides[map.map];
+    if (map.schedule.empty()) continue;  // none: on demand only
+    auto schedule = CronSchedule::Parse(map.schedule);
+    if (!schedule.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("update_map_schedules: map \"", map.map, "\": ", schedule.status().message()));
+    }
+    entry = *std::move(schedule);
+  }
   return options;
 }
 

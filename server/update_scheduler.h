@@ -83,8 +83,8 @@ class UpdateScheduler {
   std::thread thread_;
 };
 
-// The default schedule from the config (update_schedule, update_time_zone). The config has no
-// per-map overrides yet. InvalidArgument naming the setting (FinishConfig has checked both already).
+// The schedules from the config (update_schedule, update_time_zone, update_map_schedules).
+// InvalidArgument naming the setting (the config's parsers have checked them already).
 absl::StatusOr<UpdateScheduler::Options> SchedulerOptionsFromConfig(const ServerConfig& config);
 
 }  // namespace fremen::server

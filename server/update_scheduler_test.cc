@@ -234,5 +234,23 @@ TEST(UpdateSchedulerTest, OptionsFromConfig) {
   EXPECT_THAT(std::string(bad.message()), ::testing::HasSubstr("update_schedule: hour"));
 }
 
+TEST(UpdateSchedulerTest, PerMapOverridesFromConfig) {
+  ServerConfig config;
+  config.update_schedule = "0 0 * * *";
+  config.update_time_zone = "UTC";
+  config.update_map_schedules = {{"lab", "30 2 * * *"}, {"yard", ""}};
+  auto options = SchedulerOptionsFromConfig(config);
+  ASSERT_TRUE(options.ok()) << options.status();
+  ASSERT_EQ(options->overrides.size(), 2u);
+  ASSERT_TRUE(options->overrides.at("lab").has_value());
+  EXPECT_EQ(options->overrides.at("lab")->text(), "30 2 * * *");
+  EXPECT_FALSE(options->overrides.at("yard").has_value()) << "never: on demand only";
+
+  config.update_map_schedules = {{"lab", "61 2 * * *"}};
+  const absl::Status bad = SchedulerOptionsFromConfig(config).status();
+  EXPECT_EQ(bad.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(bad.message()), ::testing::HasSubstr("update_map_schedules: map \"lab\": minute"));
+}
+
 }  // namespace
 }  // namespace fremen::server
