@@ -226,8 +226,8 @@ int main(int argc, char** argv) {
 
   // 4. Lossless: per-state update time, extrapolated to 10k cells on 2 cores.
   {
-    const model::LosslessHistory cell = LosslessCell();
-    std::vector<model::LosslessHistory> copies(lossless_states, cell);
+    const fremen::model::LosslessHistory cell = LosslessCell();
+    std::vector<fremen::model::LosslessHistory> copies(lossless_states, cell);
     const auto start = Clock::now();
     std::thread other([&] {
       for (int i = 1; i < lossless_states; i += 2) (void)copies[i].Update(5);
