@@ -9,9 +9,14 @@
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <sstream>
+
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include "absl/container/flat_hash_map.h"
 #include "server/fake_clock.h"
+#include "server/logging.h"
 
 namespace fremen::server {
 namespace {
@@ -162,6 +167,34 @@ TEST_F(OperationsTest, RateAndEtaWhilePublishing) {
   EXPECT_DOUBLE_EQ(now->eta_seconds, 40.0 / 30.0);
   job_.Open("lab", 2);
   AwaitDone(op->name);
+}
+
+TEST_F(OperationsTest, ProgressIsLoggedAtASteadyCadence) {
+  // The daemon's logger, into a string.
+  std::ostringstream log;
+  auto logger = std::make_shared<spdlog::logger>(kDaemonLogger, std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  spdlog::drop(kDaemonLogger);
+  spdlog::register_logger(logger);
+  auto op = registry_.StartUpdate("lab", "RunUpdate");
+  ASSERT_TRUE(op.ok());
+  ASSERT_TRUE(job_.AwaitStep("lab", 1));
+  job_.Open("lab", 1);
+  ASSERT_TRUE(job_.AwaitStep("lab", 2));
+  // Reports every second for 12 s, as the store's slices do: a line every 5 s (the default).
+  JobControl control(&registry_, op->id, "lab");
+  for (int second = 1; second <= 12; ++second) {
+    clock_.Advance(absl::Seconds(1));
+    control.Progress(50 + second, 100);
+  }
+  job_.Open("lab", 2);
+  AwaitDone(op->name);
+  spdlog::drop(kDaemonLogger);
+  const std::string text = log.str();
+  size_t lines = 0;
+  for (size_t at = text.find("states/s"); at != std::string::npos; at = text.find("states/s", at + 1)) ++lines;
+  EXPECT_EQ(lines, 2u) << text;
+  EXPECT_THAT(text, HasSubstr("update of map lab: 55/100 states (55%)"));
+  EXPECT_THAT(text, HasSubstr("update of map lab: 60/100 states (60%)"));
 }
 
 TEST_F(OperationsTest, UpdatesOfDifferentMapsQueueOnOneThread) {
