@@ -52,25 +52,22 @@ MapInfo Grid(const std::string& name, uint32_t shards) {
 // Rows [y0, y1) of the grid at time t: a checkerboard, inverted when `flip`, so that every cell seen
 // with both is dynamic. Keys sorted, as robots send them.
 ObservationBatch Rows(const MapInfo& map, uint64_t writer, uint64_t i, uint32_t y0, uint32_t y1, double t, bool flip) {
+  std::vector<std::pair<uint64_t, float>> cells;
+  for (uint32_t y = y0; y < y1; ++y) {
+    for (uint32_t x = 0; x < kSide; ++x) {
+      cells.emplace_back(map.grid.keys().Key(x, y, 0), ((x + y) % 2 == 0) != flip ? 1.0f : 0.0f);
+    }
+  }
+  std::sort(cells.begin(), cells.end());
   ObservationBatch b;
   b.writer_id = writer;
   b.sequence = i + 1;
   b.time = t;
-  for (uint32_t y = y0; y < y1; ++y) {
-    for (uint32_t x = 0; x < kSide; ++x) {
-      b.keys.push_back(map.grid.keys().Key(x, y, 0));
-      b.values.push_back(((x + y) % 2 == 0) != flip ? 1.0f : 0.0f);
-    }
+  for (const auto& [key, value] : cells) {
+    b.keys.push_back(key);
+    b.values.push_back(value);
   }
-  std::vector<size_t> order(b.keys.size());
-  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t c) { return b.keys[a] < b.keys[c]; });
-  ObservationBatch sorted = b;
-  for (size_t k = 0; k < order.size(); ++k) {
-    sorted.keys[k] = b.keys[order[k]];
-    sorted.values[k] = b.values[order[k]];
-  }
-  return sorted;
+  return b;
 }
 
 // Observes every cell (in 64-row scans), inverting the last values, so that every cell is dynamic
@@ -169,6 +166,7 @@ int main(int argc, char** argv) {
       TouchAll(*store, sequence, kT0 + 3600.0 * sequence);
       const auto start = Clock::now();
       const auto published = store->PublishModels();
+      if (!published.ok()) return std::fprintf(stderr, "%s\n", std::string(published.status().message()).c_str()), 1;
       rates.push_back(static_cast<double>(*published) / Seconds(start, Clock::now()));
     }
     std::printf("choose + publish, 1 shard (1 core), K=24 L=5: %.2fM states/s (median of %d; target >= 2M/s/core)\n",
@@ -189,7 +187,10 @@ int main(int argc, char** argv) {
       const auto mid = Clock::now();
       (void)store->Checkpoint();
       const auto end = Clock::now();
-      if (!published.ok() || *published != kStates) std::fprintf(stderr, "published %llu\n", (unsigned long long)*published);
+      if (!published.ok() || *published != kStates) {
+        std::fprintf(stderr, "the publication did not publish every state: %s\n",
+                     published.ok() ? std::to_string(*published).c_str() : std::string(published.status().message()).c_str());
+      }
       publish.push_back(Seconds(start, mid));
       persist.push_back(Seconds(mid, end));
       const auto second = Clock::now();
