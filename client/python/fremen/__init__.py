@@ -13,15 +13,16 @@ the subpackage fremen.v1 (protoc's output for proto/fremen/v1/*.proto, which imp
 """
 
 from fremen.arrays import FlatArray
-from fremen.client import DEFAULT_ADDRESS, AnomalyCheck, Client, Prediction, ScoredState, connect
+from fremen.client import DEFAULT_ADDRESS, AnomalyCheck, Client, Prediction, Reconstruction, ScoredState, connect
 from fremen.errors import (AlreadyExists, DeadlineExceeded, Error, FailedPrecondition, InvalidArgument, NotFound,
                            OutOfRange, PermissionDenied, ResourceExhausted, Unauthenticated, Unavailable)
 from fremen.ingest import Ack, IngestSession, Rejection
 from fremen.model import Component, OrderError, Persistence, StateModel
+from fremen.retry import Backoff
 
 __all__ = [
-    "DEFAULT_ADDRESS", "Ack", "AlreadyExists", "AnomalyCheck", "Client", "Component", "DeadlineExceeded", "Error",
-    "FailedPrecondition", "FlatArray", "IngestSession", "InvalidArgument", "NotFound", "OrderError", "OutOfRange",
-    "PermissionDenied", "Persistence", "Prediction", "Rejection", "ResourceExhausted", "ScoredState", "StateModel",
-    "Unauthenticated", "Unavailable", "connect",
+    "DEFAULT_ADDRESS", "Ack", "AlreadyExists", "AnomalyCheck", "Backoff", "Client", "Component", "DeadlineExceeded",
+    "Error", "FailedPrecondition", "FlatArray", "IngestSession", "InvalidArgument", "NotFound", "OrderError",
+    "OutOfRange", "PermissionDenied", "Persistence", "Prediction", "Reconstruction", "Rejection", "ResourceExhausted",
+    "ScoredState", "StateModel", "Unauthenticated", "Unavailable", "connect",
 ]

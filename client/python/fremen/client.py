@@ -1,7 +1,10 @@
 """fremen.connect() and the Client: every call of the fremen.v1 API a map user needs, with Python
-arguments in and Python (or numpy) values out. Each call names its map in the request's `map`
-field and in the x-fremen-map header (so that a proxy can route on it), sends the bearer token when
-one was given, and turns a failed call into a fremen.Error subclass.
+arguments in and Python (or numpy) values out (the admin calls come from fremen.admin). Each call
+names its map in the request's `map` field and in the x-fremen-map header (so that a proxy can route
+on it), sends the bearer token when one was given, and turns a failed call into a fremen.Error
+subclass. Calls that may be repeated without harm (reads, RunUpdate, CancelOperation) are tried
+again after UNAVAILABLE with the connect()'s backoff; the others (create, delete, backup, restore)
+raise Unavailable at once, since the first try may have taken effect.
 
 Thread-safety: a Client may be shared by threads (gRPC channels and stubs are thread-safe); an
 IngestSession belongs to one thread.
@@ -10,20 +13,21 @@ IngestSession belongs to one thread.
 import dataclasses
 import math
 import secrets
-import time as time_module
 
 import grpc
 
 from fremen import arrays, errors, refs
+from fremen.admin import AdminCalls
 from fremen.ingest import IngestSession
 from fremen.model import StateModel
-from fremen.v1 import (admin_pb2, admin_pb2_grpc, common_pb2, ingest_pb2_grpc, maps_pb2, maps_pb2_grpc,
-                       query_pb2, query_pb2_grpc)
+from fremen.retry import Backoff, retrying
+from fremen.v1 import (admin_pb2_grpc, common_pb2, ingest_pb2_grpc, maps_pb2, maps_pb2_grpc, query_pb2,
+                       query_pb2_grpc)
 
 DEFAULT_ADDRESS = "127.0.0.1:50051"
 
 
-def connect(address=DEFAULT_ADDRESS, token=None, tls=None, timeout=30.0, use_numpy=None):
+def connect(address=DEFAULT_ADDRESS, token=None, tls=None, timeout=30.0, use_numpy=None, reconnect=Backoff()):
     """A Client of the fremend at `address` ("host:port").
 
     token: a bearer token, sent as "authorization: Bearer <token>" (needed when the daemon has
@@ -32,16 +36,21 @@ def connect(address=DEFAULT_ADDRESS, token=None, tls=None, timeout=30.0, use_num
     a PEM file of root certificates to trust (e.g. the daemon's self-signed certificate).
     timeout: seconds each unary call may take (None = no limit); ingest streams have their own.
     use_numpy: None = numpy arrays when numpy is importable, False = FlatArray always.
+    reconnect: the fremen.Backoff after UNAVAILABLE (bounded, jittered, exponential) for the calls
+    that may be repeated and for ingest sessions, which resume their stream; None = no retries.
     """
+    if reconnect is not None and not isinstance(reconnect, Backoff):
+        raise errors.InvalidArgument(f"reconnect must be a fremen.Backoff or None, got {reconnect!r}")
+    options = reconnect.channel_options() if reconnect is not None else []
     if tls is None or tls is False:
-        channel = grpc.insecure_channel(address)
+        channel = grpc.insecure_channel(address, options=options)
     else:
         root_certificates = None
         if tls is not True:
             with open(tls, "rb") as pem:
                 root_certificates = pem.read()
-        channel = grpc.secure_channel(address, grpc.ssl_channel_credentials(root_certificates))
-    return Client(channel, token=token, timeout=timeout, use_numpy=use_numpy)
+        channel = grpc.secure_channel(address, grpc.ssl_channel_credentials(root_certificates), options=options)
+    return Client(channel, token=token, timeout=timeout, use_numpy=use_numpy, reconnect=reconnect)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -52,6 +61,22 @@ class Prediction:
     probabilities: object
     states: object
     unobserved: list
+
+
+@dataclasses.dataclass(frozen=True)
+class Reconstruction:
+    """Reconstruct's answer: slots[i, k] is states[i] in the slot starting at
+    first_slot_time + k · slot_seconds: 0, 1, or UNOBSERVED (2) when nothing was observed then."""
+    first_slot_time: float
+    slot_seconds: float
+    slots: object
+
+    UNOBSERVED = 2
+
+    def slot_times(self):
+        """The start of every slot, seconds."""
+        count = self.slots.shape[1] if len(self.slots.shape) == 2 else 0
+        return [self.first_slot_time + k * self.slot_seconds for k in range(count)]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -81,11 +106,12 @@ _CRITERIA = {
 }
 
 
-class Client:
+class Client(AdminCalls):
     """Made by fremen.connect(). Usable as a context manager (closes the channel)."""
 
-    def __init__(self, channel, token=None, timeout=30.0, use_numpy=None):
+    def __init__(self, channel, token=None, timeout=30.0, use_numpy=None, reconnect=None):
         self._channel = channel
+        self._reconnect = reconnect
         self._auth = [("authorization", f"Bearer {token}")] if token else []
         self._timeout = timeout
         self._use_numpy = arrays.numpy_available() if use_numpy is None else use_numpy
@@ -111,11 +137,23 @@ class Client:
     def _metadata(self, map_name=None):
         return self._auth + ([("x-fremen-map", map_name)] if map_name else [])
 
-    def _call(self, method, request, map_name=None):
-        try:
-            return method(request, metadata=self._metadata(map_name), timeout=self._timeout)
-        except grpc.RpcError as error:
-            raise errors.error_from_rpc(error) from None
+    def _call(self, method, request, map_name=None, idempotent=True):
+        """One unary call; tried again after UNAVAILABLE (within the backoff) when `idempotent`."""
+        def attempt():
+            try:
+                return method(request, metadata=self._metadata(map_name), timeout=self._timeout)
+            except grpc.RpcError as error:
+                raise errors.error_from_rpc(error) from None
+        return retrying(self._reconnect if idempotent else None, attempt)
+
+    def _pages(self, method, request, field, map_name=None):
+        """Every element of the repeated `field` over all the pages of a List call."""
+        while True:
+            page = self._call(method, request, map_name)
+            yield from getattr(page, field)
+            if not page.next_page_token:
+                return
+            request.page_token = page.next_page_token
 
     # --- maps ---
 
@@ -165,7 +203,7 @@ class Client:
             if criterion not in _CRITERIA:
                 raise errors.InvalidArgument(f"criterion must be 'threshold' or 'squared', got {criterion!r}")
             spec.criterion = _CRITERIA[criterion]
-        return self._call(self._maps.CreateMap, maps_pb2.CreateMapRequest(map=spec), name).map
+        return self._call(self._maps.CreateMap, maps_pb2.CreateMapRequest(map=spec), name, idempotent=False).map
 
     def get_map(self, name):
         """The map (fremen.v1.Map). NotFound when there is none."""
@@ -173,32 +211,28 @@ class Client:
 
     def list_maps(self, page_size=0):
         """Every map (fremen.v1.Map) in name order, fetched a page of `page_size` at a time."""
-        token = ""
-        while True:
-            page = self._call(self._maps.ListMaps, maps_pb2.ListMapsRequest(page_size=page_size, page_token=token))
-            yield from page.maps
-            token = page.next_page_token
-            if not token:
-                return
+        yield from self._pages(self._maps.ListMaps, maps_pb2.ListMapsRequest(page_size=page_size), "maps")
 
     def delete_map(self, name):
         """Deletes the map and all its data. NotFound when there is none."""
-        self._call(self._maps.DeleteMap, maps_pb2.DeleteMapRequest(map=name), name)
+        self._call(self._maps.DeleteMap, maps_pb2.DeleteMapRequest(map=name), name, idempotent=False)
 
     # --- ingest ---
 
-    def ingest(self, map_name, writer_id=None, first_sequence=1, max_in_flight=64, timeout=None):
+    def ingest(self, map_name, writer_id=None, first_sequence=1, max_in_flight=64, timeout=None, resume=True):
         """An IngestSession streaming batches into `map_name`.
 
         (writer_id, sequence) identifies a batch: a robot that reconnects and resends batches not
         yet acknowledged must use the same writer_id and sequence numbers (the daemon answers a
         batch already applied with duplicate=True). writer_id defaults to a random number, a new
-        writer. timeout: seconds the whole stream may last (None = no limit).
+        writer. timeout: seconds the whole session may last (None = no limit). resume: after the
+        stream fails with UNAVAILABLE, open a new one with the connect()'s backoff and resend the
+        unanswered batches (False, or a client without backoff: the session fails instead).
         """
         if writer_id is None:
             writer_id = secrets.randbits(63) + 1
         return IngestSession(self._ingest.Ingest, map_name, self._metadata(map_name), writer_id, first_sequence,
-                             max_in_flight, timeout)
+                             max_in_flight, timeout, reconnect=self._reconnect if resume else None)
 
     # --- queries ---
 
@@ -246,22 +280,28 @@ class Client:
             options=refs.prediction_options(persistence, order), output=kind, confidence=confidence,
             chunk_cells=chunk_cells)
         extent = [max(h - l, 0) for l, h in zip(lo, hi)]
-        shape = tuple(reversed(extent))
         floats = dtype == "float32"
-        values = None
-        filled = 0
-        try:
-            for chunk in self._query.PredictRegion(request, metadata=self._metadata(map_name), timeout=self._timeout):
-                if values is None:
-                    values = [0.0] * chunk.box_cells if floats else bytearray(chunk.box_cells)
-                part = chunk.float_values if floats else chunk.bytes_values
-                values[chunk.offset:chunk.offset + len(part)] = part
-                filled += len(part)
-        except grpc.RpcError as error:
-            raise errors.error_from_rpc(error) from None
-        if values is None or filled != len(values) or len(values) != math.prod(extent):
-            raise errors.Error(grpc.StatusCode.DATA_LOSS,
-                               f"the region's chunks covered {filled} cells of a box of {extent} cells")
+
+        def attempt():  # the whole stream again after UNAVAILABLE: a read
+            values = None
+            filled = 0
+            try:
+                for chunk in self._query.PredictRegion(request, metadata=self._metadata(map_name),
+                                                       timeout=self._timeout):
+                    if values is None:
+                        values = [0.0] * chunk.box_cells if floats else bytearray(chunk.box_cells)
+                    part = chunk.float_values if floats else chunk.bytes_values
+                    values[chunk.offset:chunk.offset + len(part)] = part
+                    filled += len(part)
+            except grpc.RpcError as error:
+                raise errors.error_from_rpc(error) from None
+            if values is None or filled != len(values) or len(values) != math.prod(extent):
+                raise errors.Error(grpc.StatusCode.DATA_LOSS,
+                                   f"the region's chunks covered {filled} cells of a box of {extent} cells")
+            return values
+
+        values = retrying(self._reconnect, attempt)
+        shape = tuple(reversed(extent))
         if floats:
             return arrays.shaped(values, shape, dtype, self._use_numpy)
         return arrays.shaped_bytes(bytes(values), shape, self._use_numpy)
@@ -278,6 +318,21 @@ class Client:
         if raw:
             return response.model
         return StateModel.from_proto(response.model)
+
+    def reconstruct(self, map_name, start, end, *, ids=None, names=None, cells=None, points=None):
+        """The exact past states of a lossless map (created with lossless_sampling > 0) in the
+        sampling slots overlapping [start, end) seconds, of the states named (exactly one of ids=,
+        names=, cells=, points=): a Reconstruction whose slots[state, slot] is 0, 1 or 2 =
+        unobserved (a uint8 array of shape (states, slots), or a FlatArray). FailedPrecondition on
+        a map without lossless history."""
+        request = query_pb2.ReconstructRequest(map=map_name,
+                                               states=refs.state_refs("reconstruct", ids, names, cells, points),
+                                               start_time=start, end_time=end)
+        response = self._call(self._query.Reconstruct, request, map_name)
+        count = len(response.histories[0].slots) if response.histories else 0
+        data = b"".join(history.slots for history in response.histories)
+        slots = arrays.shaped_bytes(data, (len(response.histories), count), self._use_numpy)
+        return Reconstruction(response.first_slot_time, response.slot_seconds, slots)
 
     def stats(self, map_name):
         """The map's statistics (fremen.v1.MapStats: states, observations, bytes, orders, errors)."""
@@ -301,18 +356,3 @@ class Client:
             options=refs.prediction_options(persistence, order))
         response = self._call(self._query.CheckAnomalies, request, map_name)
         return AnomalyCheck(list(response.probabilities), list(response.anomalous))
-
-    # --- admin ---
-
-    def update(self, map_name, wait=True, poll_interval=0.05):
-        """Runs the update job on the map now (order selection and republication of P) and, when
-        `wait`, waits for it to finish; returns its fremen.v1.Operation. A job that ends in error
-        raises that error."""
-        operation = self._call(self._admin.RunUpdate, admin_pb2.RunUpdateRequest(map=map_name), map_name)
-        while wait and not operation.done:
-            time_module.sleep(poll_interval)
-            operation = self._call(self._admin.GetOperation,
-                                   admin_pb2.GetOperationRequest(map=map_name, name=operation.name), map_name)
-        if operation.done and operation.error.code != 0:
-            raise errors.error_from_status(operation.error.code, operation.error.message)
-        return operation

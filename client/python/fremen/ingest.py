@@ -1,4 +1,4 @@
-"""A batched ingest session over one IngestService.Ingest stream (bidirectional).
+"""A batched ingest session over IngestService.Ingest streams (bidirectional).
 
 Each send() puts one batch (one scan: a time and many (state, value) pairs) on the stream with the
 session's writer id and the next sequence number, and returns that number. The daemon answers every
@@ -11,10 +11,18 @@ reading batches (flow control) while its answers pile up, so a caller that sends
 before waiting would stall both sides. The reader keeps answers flowing; `max_in_flight` bounds the
 batches sent but not yet answered, so send() blocks instead of queueing without bound.
 
+Resuming: when the stream fails with UNAVAILABLE (the daemon restarted, the network dropped) and
+the session has a fremen.Backoff, the reader opens a new stream after each of its pauses and puts
+the unanswered() batches on it again, with their writer id and sequence numbers: the daemon applies
+those it lacks and answers the others with duplicate=True, so every batch is answered once and
+applied once. Each stream has its own queue of requests, because gRPC's sender thread of a dead
+stream may still take one batch from its queue (that batch is among the unanswered ones resent).
+
 A batch refused as a whole comes back as an Ack whose `error` is set (the stream goes on); a stream
-that fails (unknown map, missing token, daemon gone) makes the next send/wait/close raise the
-fremen.Error. Its unanswered() batches may then have been applied or not: a new session of the
-same writer id resend()s them, and the daemon applies each exactly once. Thread-safety: one thread sends; wait/close from that thread too.
+that fails otherwise (unknown map, missing token, the daemon away longer than the backoff allows)
+makes the next send/wait/close raise the fremen.Error. Its unanswered() batches may then have been
+applied or not: a new session of the same writer id resend()s them, and the daemon applies each
+exactly once. Thread-safety: one thread sends; wait/close from that thread too.
 """
 
 import collections
@@ -68,7 +76,9 @@ class Ack:
 class IngestSession:
     """Made by Client.ingest(); use as a context manager or call close()."""
 
-    def __init__(self, ingest_method, map_name, metadata, writer_id, first_sequence, max_in_flight, timeout):
+    def __init__(self, ingest_method, map_name, metadata, writer_id, first_sequence, max_in_flight, timeout,
+                 reconnect=None):
+        """reconnect: the fremen.Backoff to resume with after UNAVAILABLE; None = do not resume."""
         if max_in_flight < 1:
             raise errors.InvalidArgument(f"max_in_flight must be at least 1, got {max_in_flight}")
         self.map = map_name
@@ -76,14 +86,19 @@ class IngestSession:
         # The sequence number the next send() uses unless told otherwise.
         self.next_sequence = first_sequence
         self._max_in_flight = max_in_flight
-        self._requests = queue.Queue()
+        self._reconnect = reconnect
+        self._deadline = None if timeout is None else time_module.monotonic() + timeout
+        self._open_call = lambda requests, timeout: ingest_method(requests, metadata=metadata, timeout=timeout)
         self._lock = threading.Condition()
         self._unanswered = collections.deque()  # batches sent, oldest first, not yet answered
         self._new_acks = []
-        self._failure = None  # the fremen.Error that ended the stream
-        self._ended = False  # the daemon's side of the stream ended
+        self._failure = None  # the fremen.Error that ended the session
+        self._ended = False  # the reader is done: no more answers will come
         self._closed = False
-        self._call = ingest_method(self._request_iterator(), metadata=metadata, timeout=timeout)
+        self._cancelled = threading.Event()
+        self._reconnects = 0
+        self._requests = queue.Queue()  # the current stream's
+        self._call = self._open_stream(self._requests)
         self._reader = threading.Thread(target=self._read_acks, name=f"fremen-ingest-{map_name}", daemon=True)
         self._reader.start()
 
@@ -168,30 +183,91 @@ class IngestSession:
             # Numbers only go up: a writer's batch at or below its highest applied one is a retry.
             self.next_sequence = max(self.next_sequence, request.sequence + 1)
             self._unanswered.append(request)
-        self._requests.put(request)
+            # Under the lock: a resumed stream takes either this batch from unanswered or this
+            # queue, never neither.
+            self._requests.put(request)
         return request.sequence
 
-    def _request_iterator(self):
-        while (request := self._requests.get()) is not _END:
-            yield request
+    @property
+    def reconnects(self):
+        """How many times the session opened a new stream after UNAVAILABLE."""
+        with self._lock:
+            return self._reconnects
+
+    # --- streams ---
+
+    def _open_stream(self, requests):
+        """Starts an Ingest call that sends what `requests` (a queue ended by _END) holds."""
+        def iterate():
+            while (request := requests.get()) is not _END:
+                yield request
+        timeout = None
+        if self._deadline is not None:
+            timeout = max(self._deadline - time_module.monotonic(), 0.001)
+        return self._open_call(iterate(), timeout)
+
+    def _resume(self):
+        """Replaces the failed stream by a new one that starts with the unanswered batches. False
+        when the session was cancelled meanwhile."""
+        with self._lock:
+            if self._cancelled.is_set():
+                return False
+            dead, self._requests = self._requests, queue.Queue()
+            for batch in self._unanswered:
+                self._requests.put(batch)
+            if self._closed:
+                self._requests.put(_END)
+            self._reconnects += 1
+            self._call = self._open_stream(self._requests)
+        dead.put(_END)  # the failed stream's sender, if it still waits for a batch, stops
+        return True
 
     # --- acknowledgements ---
 
     def _read_acks(self):
+        """The reader thread: the answers of each stream, and a new stream after UNAVAILABLE for as
+        long as the backoff allows (its count of tries starts again once a stream answered)."""
+        pauses = None
+        failure = None
         try:
-            for response in self._call:
+            while True:
+                answered, failure = self._read_stream(self._call)
+                if not self._may_resume(failure):
+                    break
+                if pauses is None or answered:
+                    pauses = self._reconnect.pauses()
+                pause = next(pauses, None)
+                if pause is None or self._cancelled.wait(pause) or not self._resume():
+                    break
+        finally:
+            with self._lock:
+                self._failure = failure
+                self._ended = True
+                self._lock.notify_all()
+                requests = self._requests
+            requests.put(_END)  # the daemon is gone: stop the sender
+
+    def _read_stream(self, call):
+        """(answers read, the fremen.Error that ended the stream or None)."""
+        answered = 0
+        try:
+            for response in call:
                 with self._lock:
                     self._new_acks.append(Ack.from_proto(response))
                     self._unanswered.popleft()  # answers come in the order of the batches
                     self._lock.notify_all()
+                answered += 1
         except grpc.RpcError as error:
-            with self._lock:
-                self._failure = errors.error_from_rpc(error)
-        finally:
-            with self._lock:
-                self._ended = True
-                self._lock.notify_all()
-            self._requests.put(_END)  # the daemon is gone: stop the sender
+            return answered, errors.error_from_rpc(error)
+        return answered, None
+
+    def _may_resume(self, failure):
+        """Whether to open another stream: after UNAVAILABLE, when a backoff is set, unless the
+        session was cancelled or was closed with every batch answered (nothing left to send)."""
+        with self._lock:
+            finished = self._closed and not self._unanswered
+        return (isinstance(failure, errors.Unavailable) and self._reconnect is not None
+                and not self._cancelled.is_set() and not finished)
 
     def _raise_if_ended(self):
         # Called with the lock held.
@@ -221,12 +297,13 @@ class IngestSession:
     def close(self, timeout=None):
         """Ends the stream after the batches sent, waits for their answers and the daemon's end of
         the call; returns the Acks not yet returned by wait(). Raises the stream's fremen.Error."""
-        if not self._closed:
-            self._closed = True
-            self._requests.put(_END)
+        with self._lock:
+            if not self._closed:
+                self._closed = True
+                self._requests.put(_END)
         self._reader.join(timeout)
         if self._reader.is_alive():
-            self._call.cancel()
+            self.cancel()
             raise errors.error_for(grpc.StatusCode.DEADLINE_EXCEEDED,
                                   f"the ingest stream did not end within {timeout} s")
         return self.wait()
@@ -234,9 +311,12 @@ class IngestSession:
     def cancel(self):
         """Abandons the stream: batches not yet answered may or may not have been applied (resend
         them with the same writer id and sequence numbers to find out)."""
-        self._closed = True
-        self._call.cancel()
-        self._requests.put(_END)
+        with self._lock:
+            self._closed = True
+            self._cancelled.set()
+            call, requests = self._call, self._requests
+        call.cancel()
+        requests.put(_END)
         self._reader.join()
 
     def __enter__(self):

@@ -1,7 +1,7 @@
 """The real fremend for the package's tests, as tests/fremend_fixture.h runs it for the C++ ones.
 
-FremendProcess.start() runs $FREMEND_BINARY with --listen 127.0.0.1:0 --data-dir <dir> (plus the
-test's arguments), its output to a log file beside the data directory, learns the port from the
+FremendProcess.start() runs $FREMEND_BINARY with --listen 127.0.0.1:0 (any free port; or a given
+address, to restart a daemon where its clients expect it) --data-dir <dir> (plus the test's arguments), its output to a log file beside the data directory, learns the port from the
 line "fremend listening on HOST:PORT, ..." and returns once grpc.health.v1.Health says SERVING.
 stop() sends SIGTERM and returns the exit code. DaemonTestCase starts one daemon on a fresh
 temporary directory per test and stops it after the test, expecting exit code 0; with tokens
@@ -44,12 +44,12 @@ class FremendProcess:
         self.address = None
 
     @classmethod
-    def start(cls, data_dir, args=(), tls_root=None):
+    def start(cls, data_dir, args=(), tls_root=None, listen="127.0.0.1:0"):
         """tls_root: the PEM file of the daemon's certificate when it serves TLS."""
         log_path = f"{data_dir}.fremend-{time.monotonic_ns()}.log"
         with open(log_path, "wb") as log:
             process = subprocess.Popen(
-                [fremend_binary(), "--listen", "127.0.0.1:0", "--data-dir", data_dir, *args],
+                [fremend_binary(), "--listen", listen, "--data-dir", data_dir, *args],
                 stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
         daemon = cls(process, log_path)
         try:
@@ -134,11 +134,15 @@ class DaemonTestCase(unittest.TestCase):
         self.addCleanup(self.stop_daemon)
         self.client = self.connect(token=self.token, tls=self.certificate)
 
-    def restart_daemon(self):
-        """A new daemon on the same data directory (after the old one stopped or was killed), on a
-        new port; self.client talks to it."""
-        self.daemon = FremendProcess.start(self.path("data"), self._daemon_args, tls_root=self.certificate)
-        self.client = self.connect(token=self.token, tls=self.certificate)
+    def restart_daemon(self, same_port=False):
+        """A new daemon on the same data directory (after the old one stopped or was killed). On a
+        new port, and self.client a new client of it; or with `same_port`, where the old one
+        listened, so that the clients connected to the old one reach it."""
+        listen = self.daemon.address if same_port else "127.0.0.1:0"
+        self.daemon = FremendProcess.start(self.path("data"), self._daemon_args, tls_root=self.certificate,
+                                           listen=listen)
+        if not same_port:
+            self.client = self.connect(token=self.token, tls=self.certificate)
 
     def write(self, name, text):
         with open(self.path(name), "w") as out:
