@@ -146,6 +146,16 @@ class Client(AdminCalls):
                 raise errors.error_from_rpc(error) from None
         return retrying(self._reconnect if idempotent else None, attempt)
 
+    def _channel_ready(self, timeout):
+        """Whether the channel is connected (or connects) within `timeout` seconds."""
+        future = grpc.channel_ready_future(self._channel)
+        try:
+            future.result(timeout=timeout)
+            return True
+        except grpc.FutureTimeoutError:
+            future.cancel()  # stops watching the channel
+            return False
+
     def _pages(self, method, request, field, map_name=None):
         """Every element of the repeated `field` over all the pages of a List call."""
         while True:
@@ -232,7 +242,8 @@ class Client(AdminCalls):
         if writer_id is None:
             writer_id = secrets.randbits(63) + 1
         return IngestSession(self._ingest.Ingest, map_name, self._metadata(map_name), writer_id, first_sequence,
-                             max_in_flight, timeout, reconnect=self._reconnect if resume else None)
+                             max_in_flight, timeout, reconnect=self._reconnect if resume else None,
+                             channel_ready=self._channel_ready)
 
     # --- queries ---
 

@@ -77,8 +77,9 @@ class IngestSession:
     """Made by Client.ingest(); use as a context manager or call close()."""
 
     def __init__(self, ingest_method, map_name, metadata, writer_id, first_sequence, max_in_flight, timeout,
-                 reconnect=None):
-        """reconnect: the fremen.Backoff to resume with after UNAVAILABLE; None = do not resume."""
+                 reconnect=None, channel_ready=None):
+        """reconnect: the fremen.Backoff to resume with after UNAVAILABLE (None = do not resume);
+        channel_ready(timeout): whether the channel is connected within `timeout` seconds."""
         if max_in_flight < 1:
             raise errors.InvalidArgument(f"max_in_flight must be at least 1, got {max_in_flight}")
         self.map = map_name
@@ -87,6 +88,7 @@ class IngestSession:
         self.next_sequence = first_sequence
         self._max_in_flight = max_in_flight
         self._reconnect = reconnect
+        self._channel_ready = channel_ready
         self._deadline = None if timeout is None else time_module.monotonic() + timeout
         self._open_call = lambda requests, timeout: ingest_method(requests, metadata=metadata, timeout=timeout)
         self._lock = threading.Condition()
@@ -236,8 +238,7 @@ class IngestSession:
                     break
                 if pauses is None or answered:
                     pauses = self._reconnect.pauses()
-                pause = next(pauses, None)
-                if pause is None or self._cancelled.wait(pause) or not self._resume():
+                if not self._await_daemon(pauses) or not self._resume():
                     break
         finally:
             with self._lock:
@@ -246,6 +247,19 @@ class IngestSession:
                 self._lock.notify_all()
                 requests = self._requests
             requests.put(_END)  # the daemon is gone: stop the sender
+
+    def _await_daemon(self, pauses):
+        """Waits, a pause at a time, until the channel is connected again; False when the pauses
+        ran out or the session was cancelled. Why not simply open a stream after each pause: a
+        stream that fails at once (connection refused) while gRPC sends the batches queued on it
+        can leave gRPC's response iterator waiting for ever (python3-grpcio 1.51), so a new stream
+        is opened only on a connected channel."""
+        for pause in pauses:
+            if self._channel_ready(pause):
+                return not self._cancelled.is_set()
+            if self._cancelled.is_set():
+                return False
+        return False
 
     def _read_stream(self, call):
         """(answers read, the fremen.Error that ended the stream or None)."""
