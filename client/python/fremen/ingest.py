@@ -37,6 +37,9 @@ from fremen import errors, refs
 from fremen.v1 import common_pb2, ingest_pb2
 
 _END = object()  # ends the request iterator
+# Seconds a stream's answers may take to end after its call ended before the stream counts as
+# failed with the call's status (see _read_stream).
+STUCK_GRACE = 5.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -262,18 +265,40 @@ class IngestSession:
         return False
 
     def _read_stream(self, call):
-        """(answers read, the fremen.Error that ended the stream or None)."""
-        answered = 0
-        try:
-            for response in call:
-                with self._lock:
-                    self._new_acks.append(Ack.from_proto(response))
-                    self._unanswered.popleft()  # answers come in the order of the batches
-                    self._lock.notify_all()
-                answered += 1
-        except grpc.RpcError as error:
-            return answered, errors.error_from_rpc(error)
-        return answered, None
+        """(answers read, the fremen.Error that ended the stream or None).
+
+        The answers are read on a thread of their own because gRPC's response iterator can wait for
+        ever after its call ended (python3-grpcio 1.51, rarely, for a call that fails at once):
+        once the call is done, its answers must end within STUCK_GRACE seconds, or the stream
+        counts as failed with the call's status and the stuck thread is abandoned (anything it
+        might still read is dropped; those batches stay unanswered and are resent)."""
+        state = {"answered": 0, "abandoned": False, "failure": None}
+        finished = threading.Event()
+        call_done = threading.Event()
+
+        def receive():
+            try:
+                for response in call:
+                    with self._lock:
+                        if state["abandoned"]:
+                            return
+                        self._new_acks.append(Ack.from_proto(response))
+                        self._unanswered.popleft()  # answers come in the order of the batches
+                        state["answered"] += 1
+                        self._lock.notify_all()
+            except grpc.RpcError as error:
+                state["failure"] = errors.error_from_rpc(error)
+            finally:
+                finished.set()
+
+        threading.Thread(target=receive, name=f"fremen-ingest-answers-{self.map}", daemon=True).start()
+        call.add_done_callback(lambda _: call_done.set())
+        call_done.wait()
+        if finished.wait(STUCK_GRACE):
+            return state["answered"], state["failure"]
+        with self._lock:
+            state["abandoned"] = True
+            return state["answered"], errors.error_for(call.code(), call.details() or "the ingest stream ended")
 
     def _may_resume(self, failure):
         """Whether to open another stream: after UNAVAILABLE, when a backoff is set, unless the

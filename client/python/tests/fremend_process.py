@@ -1,7 +1,8 @@
 """The real fremend for the package's tests, as tests/fremend_fixture.h runs it for the C++ ones.
 
 FremendProcess.start() runs $FREMEND_BINARY with --listen 127.0.0.1:0 (any free port; or a given
-address, to restart a daemon where its clients expect it) --data-dir <dir> (plus the test's arguments), its output to a log file beside the data directory, learns the port from the
+address, to restart a daemon where its clients expect it) --data-dir <dir> (plus the test's
+arguments), its output to a log file beside the data directory, learns the port from the
 line "fremend listening on HOST:PORT, ..." and returns once grpc.health.v1.Health says SERVING.
 stop() sends SIGTERM and returns the exit code. DaemonTestCase starts one daemon on a fresh
 temporary directory per test and stops it after the test, expecting exit code 0; with tokens

@@ -28,7 +28,8 @@ class AdminTest(DaemonTestCase):
         self.client.create_map(name, size=(BIG_NX, BIG_NY), resolution=0.1)
         with self.client.ingest(name) as session:
             for i, byte in enumerate((0, 255)):
-                session.send_patch(T + 60 * i, (0, 0), (BIG_NX, BIG_NY), probabilities=bytes([byte]) * (BIG_NX * BIG_NY))
+                session.send_patch(T + 60 * i, (0, 0), (BIG_NX, BIG_NY),
+                                   probabilities=bytes([byte]) * (BIG_NX * BIG_NY))
             self.assertEqual([a.accepted for a in session.wait(timeout=120)], [BIG_NX * BIG_NY] * 2)
 
     # --- backup, restore ---

@@ -2,7 +2,9 @@
 directory and port: an ingest session that keeps sending through the restart resumes by itself and
 every batch is answered once and applied exactly once (observation counts); unary reads retry until
 the daemon is back; and the bounds: a daemon that stays away ends in fremen.Unavailable (the
-unanswered batches kept for a manual resend), as do calls that are not retried."""
+unanswered batches kept for a manual resend), as do calls that are not retried. StuckStreamTest
+injects the one fault a real daemon cannot cause: a stream whose call ended while gRPC's response
+iterator waits for ever; the session abandons it and resumes (or fails, without resume)."""
 
 import os
 import signal
@@ -10,7 +12,10 @@ import threading
 import time
 import unittest
 
+import grpc
+
 import fremen
+from fremen import ingest
 from fremend_process import DaemonTestCase
 
 T = 1.7e9
@@ -136,6 +141,72 @@ class ReconnectTest(DaemonTestCase):
             session.wait(timeout=30)
         self.assertEqual(session.reconnects, 0)
         self.restart_daemon()
+
+
+
+class StuckCall:
+    """Fault injection: an Ingest call that ended with UNAVAILABLE while its response iterator waits
+    for ever, as python3-grpcio 1.51's sometimes does for a call that fails at once."""
+
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        threading.Event().wait()
+
+    def add_done_callback(self, callback):
+        callback(self)
+
+    def code(self):
+        return grpc.StatusCode.UNAVAILABLE
+
+    def details(self):
+        return "failed to connect to all addresses"
+
+    def cancel(self):
+        return False
+
+
+class FirstStreamStuck:
+    """The client's IngestService stub, whose first stream is a StuckCall."""
+
+    def __init__(self, stub):
+        self.stub = stub
+        self.streams = 0
+
+    def Ingest(self, requests, metadata=None, timeout=None):  # noqa: N802 (the stub's name)
+        self.streams += 1
+        if self.streams == 1:
+            return StuckCall()
+        return self.stub.Ingest(requests, metadata=metadata, timeout=timeout)
+
+
+class StuckStreamTest(DaemonTestCase):
+    def setUp(self):
+        super().setUp()
+        grace, ingest.STUCK_GRACE = ingest.STUCK_GRACE, 0.2
+        self.addCleanup(setattr, ingest, "STUCK_GRACE", grace)
+        self.client.create_map("doors")
+        self.client._ingest = FirstStreamStuck(self.client._ingest)
+
+    def test_a_stuck_stream_is_abandoned_and_its_batches_resent(self):
+        session = self.client.ingest("doors", writer_id=3)
+        for i in range(3):
+            session.send(T + i, [1], names=["a"])
+        acks = session.wait(timeout=30)
+        self.assertEqual([(a.sequence, a.accepted, a.duplicate) for a in acks],
+                         [(1, 1, False), (2, 1, False), (3, 1, False)])
+        self.assertEqual(session.reconnects, 1)
+        self.assertEqual(self.client.stats("doors").observations, 3)
+        session.close()
+
+    def test_without_resume_a_stuck_stream_fails_with_its_status(self):
+        session = self.client.ingest("doors", resume=False)
+        session.send(T, [1], names=["a"])
+        with self.assertRaises(fremen.Unavailable) as raised:
+            session.wait(timeout=30)
+        self.assertIn("failed to connect", raised.exception.message)
+        self.assertEqual(len(session.unanswered()), 1)
 
 
 if __name__ == "__main__":
