@@ -83,7 +83,7 @@ void RegisterPredictCommand(CLI::App& app) {
     const std::vector<std::string> labels = StateLabels(a->states);
     std::vector<bool> unobserved(labels.size());
     for (uint32_t j : p->unobserved) unobserved[j] = true;
-    std::printf("%-20s  %-20s  %-6s%s\n", "TIME", "STATE", "P", a->confidence ? "  STATE" : "");
+    std::printf("%-20s  %-20s  %-6s%s\n", "TIME", "STATE", "P", a->confidence ? "  P>=C" : "");
     for (uint32_t i = 0; i < p->time_count; ++i) {
       for (uint32_t j = 0; j < p->state_count; ++j) {
         std::string line = absl::StrFormat("%-20s  %-20s  %.4f", TimeLabel(times[i]), labels[j], p->probability(i, j));
