@@ -485,9 +485,7 @@ TEST(ClientConnectionTest, TlsWithTheDaemonsRootCertificate) {
 
 class ClientTokenTest : public DaemonTest {
  protected:
-  void SetUp() override {
-    StartDaemon({"--tokens", "read:reader-token write:writer-token"});
-  }
+  void SetUp() override { StartDaemon({"--tokens", "read:reader-token write:writer-token"}); }
   Client As(const std::string& token) {
     ConnectionOptions options;
     options.address = daemon_->address();

@@ -157,7 +157,7 @@ TEST_F(FremenctlTest, MapsBadInputSaysWhatToFix) {
   EXPECT_EQ(unconfirmed.exit_code, 2);
   EXPECT_THAT(unconfirmed.err, HasSubstr("add --yes"));
   EXPECT_THAT(Run("maps list").out, HasSubstr("lab"));  // still there
-  EXPECT_EQ(Run("maps").exit_code, 2);                 // a subcommand is required
+  EXPECT_EQ(Run("maps").exit_code, 2);                  // a subcommand is required
 }
 
 // --- queries ---
@@ -207,7 +207,9 @@ TEST_F(FremenctlTest, TopRanksTheGroup) {
   ASSERT_TRUE(session.ok());
   for (int i = 0; i < 24; ++i) {
     ScanBuilder scan(kStart + i * 3600.0);
-    scan.AddState(1, 1, "front", "entrances").AddState(2, 0, "back", "entrances").AddState(3, i % 2, "side", "entrances");
+    scan.AddState(1, 1, "front", "entrances")
+        .AddState(2, 0, "back", "entrances")
+        .AddState(3, i % 2, "side", "entrances");
     ASSERT_TRUE((*session)->Send(*scan.Build()).ok());
   }
   ASSERT_TRUE((*session)->Close(absl::Seconds(30)).ok());
@@ -227,8 +229,9 @@ TEST_F(FremenctlTest, TopRanksTheGroup) {
 TEST_F(FremenctlTest, AnomaliesFlagsWhatContradictsThePattern) {
   CreateGrid("lab");
   IngestTwoWeeks("lab");
-  Result r = Run("anomalies --map lab --cell 2,3 --cell 2,3 --value 0 --value 1 --time 2023-11-28T12:00:00Z "
-                 "--confidence 0.7");
+  Result r =
+      Run("anomalies --map lab --cell 2,3 --cell 2,3 --value 0 --value 1 --time 2023-11-28T12:00:00Z "
+          "--confidence 0.7");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("yes"));
   EXPECT_THAT(r.out, HasSubstr("1 of 2 observations anomalous at confidence 0.7"));

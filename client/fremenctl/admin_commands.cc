@@ -29,8 +29,8 @@ absl::Status ExplainDirectory(const absl::Status& status) {
     return absl::AlreadyExistsError(absl::StrCat(status.message(), "; pick a new directory name"));
   }
   if (absl::IsInvalidArgument(status) && absl::StrContains(status.message(), "directory")) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        status.message(), " (a directory is relative to the daemon's backup root, config backup_dir)"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(status.message(), " (a directory is relative to the daemon's backup root, config backup_dir)"));
   }
   return status;
 }
@@ -71,7 +71,8 @@ void RegisterRestoreCommand(CLI::App& app) {
     if (!map.ok()) {
       absl::Status status = map.status();
       if (absl::IsAlreadyExists(status)) {
-        status = absl::AlreadyExistsError(absl::StrCat(status.message(), "; restore under another name with --as NAME"));
+        status =
+            absl::AlreadyExistsError(absl::StrCat(status.message(), "; restore under another name with --as NAME"));
       }
       FailCall("restore", absl::StrCat("backup ", a->directory), status);
     }
@@ -95,7 +96,8 @@ void RegisterStatusCommand(CLI::App& app) {
                 static_cast<unsigned long long>(s->state_count()),
                 static_cast<unsigned long long>(s->dynamic_state_count()));
     std::printf("free space: %s\n", FormatBytes(s->data_dir_free_bytes()).c_str());
-    std::printf("security: %s, %s\n", s->tls() ? "TLS" : "no TLS", s->tokens_required() ? "tokens required" : "no tokens");
+    std::printf("security: %s, %s\n", s->tls() ? "TLS" : "no TLS",
+                s->tokens_required() ? "tokens required" : "no tokens");
     if (s->update_schedule().empty()) {
       std::printf("update schedule: none\n");
     } else {

@@ -17,7 +17,8 @@ absl::StatusOr<double> ParseTimeArg(absl::string_view text, absl::Time now) {
   } else {
     absl::Time time;
     std::string error;
-    if (absl::ParseTime(absl::RFC3339_full, text, &time, &error)) return absl::ToDoubleSeconds(time - absl::UnixEpoch());
+    if (absl::ParseTime(absl::RFC3339_full, text, &time, &error))
+      return absl::ToDoubleSeconds(time - absl::UnixEpoch());
   }
   return absl::InvalidArgumentError(absl::StrCat("time \"", text,
                                                  "\" is not \"now\", seconds since 1970, or RFC 3339 like "

@@ -36,9 +36,12 @@ struct CreateArgs {
 
 std::string KindName(v1::MapKind kind) {
   switch (kind) {
-    case v1::MAP_KIND_GRID: return "grid";
-    case v1::MAP_KIND_GENERIC: return "generic";
-    default: return "?";
+    case v1::MAP_KIND_GRID:
+      return "grid";
+    case v1::MAP_KIND_GENERIC:
+      return "generic";
+    default:
+      return "?";
   }
 }
 
@@ -84,8 +87,9 @@ v1::Map MapOf(const CreateArgs& a) {
   map.set_kind(a.generic ? v1::MAP_KIND_GENERIC : v1::MAP_KIND_GRID);
   if (!a.generic) {
     if (a.resolution <= 0 || a.size.empty()) {
-      FailUsage("maps create", "a grid map needs --resolution METRES and --size X Y [Z] (or --generic for a map of "
-                               "named states)");
+      FailUsage("maps create",
+                "a grid map needs --resolution METRES and --size X Y [Z] (or --generic for a map of "
+                "named states)");
     }
     map.mutable_grid()->set_resolution(a.resolution);
     map.mutable_grid()->mutable_size()->set_x(a.size[0]);
@@ -137,9 +141,10 @@ void RegisterCreate(CLI::App& maps) {
     auto created = client.CreateMap(MapOf(*a), GlobalCall());
     if (!created.ok()) {
       if (absl::IsAlreadyExists(created.status())) {
-        FailCall("maps create", a->name, absl::AlreadyExistsError(absl::StrCat(
-                                             created.status().message(),
-                                             "; pick another name, or `fremenctl maps delete ", a->name, " --yes`")));
+        FailCall(
+            "maps create", a->name,
+            absl::AlreadyExistsError(absl::StrCat(
+                created.status().message(), "; pick another name, or `fremenctl maps delete ", a->name, " --yes`")));
       }
       FailCall("maps create", a->name, created.status());
     }
@@ -165,7 +170,8 @@ void RegisterList(CLI::App& maps) {
     }
     std::printf("%-32s %-40s %s\n", "NAME", "SHAPE", "CREATED");
     for (const v1::Map& map : *all) {
-      std::printf("%-32s %-40s %s\n", map.name().c_str(), Shape(map).c_str(), FormatTimestamp(map.create_time()).c_str());
+      std::printf("%-32s %-40s %s\n", map.name().c_str(), Shape(map).c_str(),
+                  FormatTimestamp(map.create_time()).c_str());
     }
   });
 }

@@ -13,11 +13,16 @@ namespace {
 
 std::string StageName(const v1::Operation& op) {
   switch (op.stage()) {
-    case v1::OPERATION_STAGE_QUEUED: return "queued";
-    case v1::OPERATION_STAGE_RUNNING: return "running";
-    case v1::OPERATION_STAGE_PUBLISHING: return "publishing";
-    case v1::OPERATION_STAGE_DONE: return "done";
-    default: return op.done() ? "done" : "running";
+    case v1::OPERATION_STAGE_QUEUED:
+      return "queued";
+    case v1::OPERATION_STAGE_RUNNING:
+      return "running";
+    case v1::OPERATION_STAGE_PUBLISHING:
+      return "publishing";
+    case v1::OPERATION_STAGE_DONE:
+      return "done";
+    default:
+      return op.done() ? "done" : "running";
   }
 }
 

@@ -164,7 +164,8 @@ void RegisterAnomaliesCommand(CLI::App& app) {
     for (size_t i = 0; i < result->size(); ++i) {
       const Anomaly& x = (*result)[i];
       count += x.anomalous;
-      std::printf("%-20s  %-5g  %.4f  %s\n", labels[i].c_str(), a->values[i], x.probability, x.anomalous ? "yes" : "no");
+      std::printf("%-20s  %-5g  %.4f  %s\n", labels[i].c_str(), a->values[i], x.probability,
+                  x.anomalous ? "yes" : "no");
     }
     std::printf("%zu of %zu observations anomalous at confidence %g\n", count, result->size(), a->confidence);
   });
@@ -188,7 +189,8 @@ void RegisterStatsCommand(CLI::App& app) {
     std::printf("states: %llu (%llu dynamic)\n", static_cast<unsigned long long>(s->states()),
                 static_cast<unsigned long long>(s->dynamic_states()));
     std::printf("observations: %llu\n", static_cast<unsigned long long>(s->observations()));
-    std::printf("orders: %s (dynamic states by selected order 0..L)\n", absl::StrJoin(s->order_histogram(), " ").c_str());
+    std::printf("orders: %s (dynamic states by selected order 0..L)\n",
+                absl::StrJoin(s->order_histogram(), " ").c_str());
     std::printf("mean prediction error: %.4f\n", s->mean_prediction_error());
     std::printf("compression ratio: %.1f\n", s->compression_ratio());
     std::printf("disk: %s, memory: %s, log: %s\n", FormatBytes(s->disk_bytes()).c_str(),

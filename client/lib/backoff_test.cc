@@ -16,7 +16,7 @@ RetryPolicy Policy(double jitter) {
 
 TEST(BackoffTest, DoublesFromTheInitialDelayUpToTheCap) {
   Backoff backoff(Policy(0), 1);
-  const absl::Duration expected[] = {absl::Milliseconds(100), absl::Milliseconds(200), absl::Milliseconds(400),
+  const absl::Duration expected[] = {absl::Milliseconds(100), absl::Milliseconds(200),  absl::Milliseconds(400),
                                      absl::Milliseconds(800), absl::Milliseconds(1600), absl::Seconds(2),
                                      absl::Seconds(2)};
   for (absl::Duration want : expected) EXPECT_EQ(backoff.Next(), want);

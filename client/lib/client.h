@@ -158,9 +158,8 @@ class Client {
   absl::StatusOr<v1::Operation> RunUpdate(absl::string_view map, const CallOptions& call = {}) const;
   absl::StatusOr<v1::Operation> GetOperation(absl::string_view map, absl::string_view name,
                                              const CallOptions& call = {}) const;
-  absl::StatusOr<OperationPage> ListOperations(absl::string_view map = "", bool running_only = false,
-                                               int page_size = 0, const std::string& page_token = "",
-                                               const CallOptions& call = {}) const;
+  absl::StatusOr<OperationPage> ListOperations(absl::string_view map = "", bool running_only = false, int page_size = 0,
+                                               const std::string& page_token = "", const CallOptions& call = {}) const;
   absl::StatusOr<v1::Operation> CancelOperation(absl::string_view map, absl::string_view name,
                                                 const CallOptions& call = {}) const;
   // Polls the operation until it is done and returns it (done, with its result or its error:

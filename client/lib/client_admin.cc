@@ -64,15 +64,16 @@ absl::StatusOr<v1::Operation> Client::CancelOperation(absl::string_view map, abs
 
 absl::StatusOr<v1::Operation> Client::WaitOperation(absl::string_view map, absl::string_view name,
                                                     const WaitOptions& wait, const CallOptions& call) const {
-  const absl::Time give_up = wait.timeout == absl::InfiniteDuration() ? absl::InfiniteFuture() : absl::Now() + wait.timeout;
+  const absl::Time give_up =
+      wait.timeout == absl::InfiniteDuration() ? absl::InfiniteFuture() : absl::Now() + wait.timeout;
   for (;;) {
     auto operation = GetOperation(map, name, call);
     if (!operation.ok()) return operation.status();
     if (wait.on_progress) wait.on_progress(*operation);
     if (operation->done()) return operation;
     if (absl::Now() + wait.poll_interval > give_up) {
-      return absl::DeadlineExceededError(absl::StrCat("operation \"", name, "\" of map \"", map, "\" still running after ",
-                                                      absl::FormatDuration(wait.timeout)));
+      return absl::DeadlineExceededError(absl::StrCat("operation \"", name, "\" of map \"", map,
+                                                      "\" still running after ", absl::FormatDuration(wait.timeout)));
     }
     absl::SleepFor(wait.poll_interval);
   }

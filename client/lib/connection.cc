@@ -72,7 +72,8 @@ uint64_t RandomSeed() {
 absl::StatusOr<std::shared_ptr<Connection>> Connection::Open(ConnectionOptions options) {
   if (absl::Status valid = Validate(options); !valid.ok()) return valid;
   auto channel = grpc::CreateCustomChannel(options.address, CredentialsOf(options), ChannelArgumentsOf(options));
-  if (channel == nullptr) return absl::InvalidArgumentError(absl::StrCat("address \"", options.address, "\" is not usable"));
+  if (channel == nullptr)
+    return absl::InvalidArgumentError(absl::StrCat("address \"", options.address, "\" is not usable"));
   return std::shared_ptr<Connection>(new Connection(std::move(options), std::move(channel)));
 }
 

@@ -19,7 +19,7 @@ constexpr auto kWriterGrace = std::chrono::seconds(1);
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<IngestSession>> IngestSession::Open(std::shared_ptr<Connection> connection,
-                                                                  std::string map, IngestOptions options) {
+                                                                   std::string map, IngestOptions options) {
   if (map.empty()) return absl::InvalidArgumentError("map is empty: name the map to ingest into");
   if (options.first_sequence == 0) return absl::InvalidArgumentError("first_sequence must be at least 1");
   if (options.max_unacknowledged == 0) return absl::InvalidArgumentError("max_unacknowledged must be at least 1");
@@ -27,13 +27,13 @@ absl::StatusOr<std::unique_ptr<IngestSession>> IngestSession::Open(std::shared_p
   v1::GetMapRequest request;
   request.set_map(map);
   v1::GetMapResponse response;
-  absl::Status exists = connection->CallIdempotent({}, map, [&](grpc::ClientContext& context) {
-    return connection->maps().GetMap(&context, request, &response);
-  });
+  absl::Status exists = connection->CallIdempotent(
+      {}, map, [&](grpc::ClientContext& context) { return connection->maps().GetMap(&context, request, &response); });
   if (!exists.ok()) return exists;
   uint64_t writer = options.writer_id;
   while (writer == 0) writer = RandomSeed();
-  std::unique_ptr<IngestSession> session(new IngestSession(std::move(connection), std::move(map), std::move(options), writer));
+  std::unique_ptr<IngestSession> session(
+      new IngestSession(std::move(connection), std::move(map), std::move(options), writer));
   session->thread_ = std::thread([s = session.get()] { s->Run(); });
   return session;
 }
@@ -63,9 +63,8 @@ absl::StatusOr<uint64_t> IngestSession::Send(Scan scan) {
   uint64_t sequence;
   {
     std::unique_lock lock(mutex_);
-    changed_.wait(lock, [&] {
-      return !error_.ok() || closing_ || stopping_ || pending_.size() < options_.max_unacknowledged;
-    });
+    changed_.wait(
+        lock, [&] { return !error_.ok() || closing_ || stopping_ || pending_.size() < options_.max_unacknowledged; });
     if (!error_.ok()) return error_;
     if (closing_ || stopping_) return absl::FailedPreconditionError("the ingest session is closed: open a new one");
     sequence = next_sequence_++;
@@ -267,10 +266,10 @@ void IngestSession::Run() {
     const absl::Time now = absl::Now();
     if (!failing_since) failing_since = now;
     if (now - *failing_since >= options_.reconnect_timeout || !backoff.MayRetry()) {
-      return FailLocked(absl::UnavailableError(absl::StrCat(
-          "gave up reconnecting to fremend at ", connection_->address(), " after ",
-          absl::FormatDuration(now - *failing_since), " with ", pending_.size(),
-          " batches not acknowledged; last error: ", status.message())));
+      return FailLocked(
+          absl::UnavailableError(absl::StrCat("gave up reconnecting to fremend at ", connection_->address(), " after ",
+                                              absl::FormatDuration(now - *failing_since), " with ", pending_.size(),
+                                              " batches not acknowledged; last error: ", status.message())));
     }
     const absl::Duration delay = backoff.Next();
     changed_.wait_for(lock, absl::ToChronoNanoseconds(delay), [&] { return stopping_; });

@@ -73,10 +73,10 @@ struct IngestTotals {
   uint64_t sent = 0;          // batches given to Send
   uint64_t acknowledged = 0;  // batches answered (including duplicates and refused ones)
   uint64_t duplicates = 0;
-  uint64_t refused = 0;       // batches with an error
-  uint64_t accepted = 0;      // observations
-  uint64_t rejected = 0;      // observations
-  uint64_t reconnects = 0;    // streams opened after the first
+  uint64_t refused = 0;     // batches with an error
+  uint64_t accepted = 0;    // observations
+  uint64_t rejected = 0;    // observations
+  uint64_t reconnects = 0;  // streams opened after the first
 };
 
 struct IngestOptions {
@@ -100,8 +100,8 @@ class IngestSession {
  public:
   // Checks that `map` exists (NOT_FOUND otherwise, with the daemon's message) and starts the
   // session. The stream itself opens with the first batch.
-  static absl::StatusOr<std::unique_ptr<IngestSession>> Open(std::shared_ptr<Connection> connection,
-                                                            std::string map, IngestOptions options = {});
+  static absl::StatusOr<std::unique_ptr<IngestSession>> Open(std::shared_ptr<Connection> connection, std::string map,
+                                                             IngestOptions options = {});
   // Stops at once: batches not yet acknowledged are abandoned (call Close first to wait for them).
   ~IngestSession();
   IngestSession(const IngestSession&) = delete;

@@ -19,7 +19,8 @@ RegionAssembler::RegionAssembler(GridShape shape, v1::RegionOutput output) {
 absl::Status RegionAssembler::Add(const v1::PredictRegionResponse& chunk) {
   const uint64_t total = array_.shape.cells();
   if (chunk.box_cells() != total) {
-    return absl::DataLossError(absl::StrCat("region chunk says the box has ", chunk.box_cells(), " cells, not ", total));
+    return absl::DataLossError(
+        absl::StrCat("region chunk says the box has ", chunk.box_cells(), " cells, not ", total));
   }
   if (chunk.offset() != received_) {
     return absl::DataLossError(absl::StrCat("region chunk at offset ", chunk.offset(), " where ", received_,

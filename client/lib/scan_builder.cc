@@ -35,11 +35,11 @@ bool ScanBuilder::Use(Kind kind, const char* what) {
     return true;
   }
   if (kind_ == kind && kind != Kind::kPatch) return true;
-  error_ = absl::InvalidArgumentError(
-      kind == Kind::kPatch && kind_ == Kind::kPatch
-          ? std::string("a scan holds one patch: build one scan per patch")
-          : absl::StrCat("a scan holds one kind of observations: this one has ", KindName(static_cast<int>(kind_)),
-                         ", so ", what, " needs a scan of its own"));
+  error_ = absl::InvalidArgumentError(kind == Kind::kPatch && kind_ == Kind::kPatch
+                                          ? std::string("a scan holds one patch: build one scan per patch")
+                                          : absl::StrCat("a scan holds one kind of observations: this one has ",
+                                                         KindName(static_cast<int>(kind_)), ", so ", what,
+                                                         " needs a scan of its own"));
   return false;
 }
 
@@ -82,9 +82,9 @@ ScanBuilder& ScanBuilder::SetPatch(Cell origin, GridShape shape, std::vector<flo
 ScanBuilder& ScanBuilder::SetPatchBytes(Cell origin, GridShape shape, std::string probabilities) {
   if (!Use(Kind::kPatch, "SetPatchBytes")) return *this;
   if (probabilities.size() != shape.cells()) {
-    error_ = absl::InvalidArgumentError(absl::StrCat("SetPatchBytes: ", probabilities.size(), " bytes for a patch of ",
-                                                     shape.x, "×", shape.y, "×", shape.z, " = ", shape.cells(),
-                                                     " cells"));
+    error_ =
+        absl::InvalidArgumentError(absl::StrCat("SetPatchBytes: ", probabilities.size(), " bytes for a patch of ",
+                                                shape.x, "×", shape.y, "×", shape.z, " = ", shape.cells(), " cells"));
     return *this;
   }
   v1::DensePatch* patch = request_.mutable_patch();
@@ -119,9 +119,11 @@ absl::StatusOr<Scan> ScanBuilder::Build() {
   absl::Status error = error_;
   const double time = request_.time();
   if (error.ok() && !(std::isfinite(time) && std::abs(time) <= kMaxAbsTime)) {
-    error = absl::InvalidArgumentError(absl::StrCat("time is ", time, ": a scan's time must be finite seconds, |t| ≤ 1e13"));
+    error = absl::InvalidArgumentError(
+        absl::StrCat("time is ", time, ": a scan's time must be finite seconds, |t| ≤ 1e13"));
   }
-  if (error.ok() && observations_ == 0) error = absl::InvalidArgumentError("the scan has no observations: add some first");
+  if (error.ok() && observations_ == 0)
+    error = absl::InvalidArgumentError("the scan has no observations: add some first");
   Scan scan;
   if (error.ok()) {
     // Names and groups go on the wire only when some are set: they are either empty or one per state.
