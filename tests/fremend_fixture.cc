@@ -1,12 +1,16 @@
 #include "tests/fremend_fixture.h"
 
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <sys/prctl.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string_view>
@@ -77,6 +81,23 @@ std::string TempDir::Write(const std::string& name, const std::string& text) con
   return path;
 }
 
+std::string FreeLoopbackAddress() {
+  // Bind port 0, read the port the kernel chose, release it. Another process could take it before
+  // the daemon binds it; on a test machine that is rare, and the daemon's start then fails loudly.
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = 0;
+  socklen_t length = sizeof address;
+  if (fd < 0 || bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
+      getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
+    abort();
+  }
+  close(fd);
+  return absl::StrCat("127.0.0.1:", ntohs(address.sin_port));
+}
+
 RunResult RunFremend(const std::vector<std::string>& args) {
   TempDir dir;
   const std::string log_path = dir.Path("output");
@@ -89,7 +110,11 @@ RunResult RunFremend(const std::vector<std::string>& args) {
 absl::StatusOr<std::unique_ptr<FremendProcess>> FremendProcess::Start(
     const std::string& data_dir, const std::vector<std::string>& args,
     std::shared_ptr<grpc::ChannelCredentials> credentials) {
-  std::vector<std::string> all_args = {"--listen", "127.0.0.1:0", "--data-dir", data_dir};
+  std::vector<std::string> all_args = {"--data-dir", data_dir};
+  // Any free port, unless the test chose one (to restart a daemon where its clients expect it).
+  if (std::find(args.begin(), args.end(), "--listen") == args.end()) {
+    all_args.insert(all_args.end(), {"--listen", "127.0.0.1:0"});
+  }
   all_args.insert(all_args.end(), args.begin(), args.end());
   // The log sits beside the data directory, so that it survives the daemon for the test to read.
   static int starts = 0;

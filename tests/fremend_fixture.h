@@ -1,7 +1,9 @@
 // End-to-end test support: the real fremend binary (FREMEND_BINARY, set by CMake) run as a child
 // process on a free loopback port, with a data directory the test owns, and gRPC channels to it.
 //
-// FremendProcess::Start passes --listen 127.0.0.1:0 (the daemon logs the port it was given),
+// FremendProcess::Start passes --listen 127.0.0.1:0 (the daemon logs the port it was given) unless
+// the test's args have a --listen of their own (FreeLoopbackPort: a daemon restarted on the same
+// address, as its clients expect),
 // sends the daemon's output to a log file, and returns once the daemon has logged its address and
 // the health service says SERVING. Stop() sends SIGTERM and returns the exit code; Kill() is
 // kill -9. A test restarts a daemon on the same data directory to check what survives. A daemon
@@ -47,6 +49,10 @@ struct RunResult {
   int exit_code = -1;  // -1: did not exit normally
   std::string output;  // stdout and stderr
 };
+
+// A loopback port free at the time of the call ("127.0.0.1:PORT"), for a daemon that must come back
+// on the same address after a restart.
+std::string FreeLoopbackAddress();
 
 // Runs fremend with `args` to completion (help, bad configuration, --check-config).
 RunResult RunFremend(const std::vector<std::string>& args);

@@ -1,0 +1,178 @@
+// A robot's ingest session: scans sent over IngestService.Ingest (one bidirectional stream) and
+// acknowledged once durable, surviving daemon restarts and link drops without losing or
+// duplicating a batch.
+//
+// How: every batch gets (writer_id, sequence) — sequences increase by one per Send — and stays in
+// the session until the daemon acknowledges it. When the stream breaks with UNAVAILABLE (daemon
+// restarting or gone, link lost), the session opens a new stream with exponential backoff and
+// resends every unacknowledged batch in order; the daemon answers a batch it had already applied
+// with duplicate = true and does not apply it again (it keeps the highest applied sequence per
+// writer, storage/dedup_table.h). So each batch is applied exactly once.
+//
+// - Send blocks while max_unacknowledged batches await their ack (backpressure: memory stays
+//   bounded while the daemon is away), and returns the batch's sequence.
+// - Flush blocks until every batch sent so far is acknowledged.
+// - Acks (accepted/rejected counts, the first rejections with their reasons, or the batch's error
+//   when it was refused as a whole) arrive in sequence order: through TakeAcks, totals(), and the
+//   optional on_ack callback.
+// - An error that retrying cannot fix (unknown map, bad token, a store that refuses writes) or
+//   reconnecting for longer than reconnect_timeout ends the session: Send, Flush and Close return
+//   it from then on; unacknowledged() tells how many batches were not applied for sure.
+// - Reusing a writer_id across processes: start at a first_sequence above every sequence that
+//   writer used before, or the daemon takes the new batches for retries (a random writer_id, the
+//   default, avoids that).
+//
+// Thread-safety: Send, Flush, Close, TakeAcks and the accessors may be called from any threads; a
+// background thread reads acks and reconnects. on_ack runs on that thread: it must not block or
+// call into the session.
+#pragma once
+
+#include <grpcpp/grpcpp.h>
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "client/lib/connection.h"
+#include "client/lib/scan_builder.h"
+#include "fremen/v1/ingest.grpc.pb.h"
+
+namespace fremen::client {
+
+struct Rejection {
+  // Position of the observation in the scan (for a patch: the offset, x fastest).
+  uint32_t index = 0;
+  v1::RejectReason reason = v1::REJECT_REASON_UNSPECIFIED;
+};
+
+// The daemon's answer to one batch.
+struct IngestAck {
+  uint64_t sequence = 0;
+  uint64_t accepted = 0;
+  uint64_t rejected = 0;
+  // Applied before (the batch was resent after a reconnect); nothing applied this time.
+  bool duplicate = false;
+  // The first rejections (at most 16).
+  std::vector<Rejection> rejections;
+  // Not OK when the batch was refused as a whole (nothing of it applied): the code and the daemon's
+  // message naming the field at fault. Such a batch is not resent.
+  absl::Status error;
+};
+
+struct IngestTotals {
+  uint64_t sent = 0;          // batches given to Send
+  uint64_t acknowledged = 0;  // batches answered (including duplicates and refused ones)
+  uint64_t duplicates = 0;
+  uint64_t refused = 0;       // batches with an error
+  uint64_t accepted = 0;      // observations
+  uint64_t rejected = 0;      // observations
+  uint64_t reconnects = 0;    // streams opened after the first
+};
+
+struct IngestOptions {
+  // Who writes; 0 = a random id for this session.
+  uint64_t writer_id = 0;
+  // The first batch's sequence. REQUIRES: ≥ 1. Default: 1.
+  uint64_t first_sequence = 1;
+  // Batches sent but not yet acknowledged before Send blocks. Bounds memory and what a reconnect
+  // resends. REQUIRES: ≥ 1. Default: 64.
+  size_t max_unacknowledged = 64;
+  // Give up when no stream has worked for this long (InfiniteDuration: never). Default: 5 min.
+  absl::Duration reconnect_timeout = absl::Minutes(5);
+  // Keep acks for TakeAcks (turn off when only totals() or on_ack are used, so they do not pile
+  // up). Default: true.
+  bool collect_acks = true;
+  // Called for every ack, in sequence order, on the session's thread.
+  std::function<void(const IngestAck&)> on_ack;
+};
+
+class IngestSession {
+ public:
+  // Checks that `map` exists (NOT_FOUND otherwise, with the daemon's message) and starts the
+  // session. The stream itself opens with the first batch.
+  static absl::StatusOr<std::unique_ptr<IngestSession>> Open(std::shared_ptr<Connection> connection,
+                                                            std::string map, IngestOptions options = {});
+  // Stops at once: batches not yet acknowledged are abandoned (call Close first to wait for them).
+  ~IngestSession();
+  IngestSession(const IngestSession&) = delete;
+  IngestSession& operator=(const IngestSession&) = delete;
+
+  // Queues the scan for sending and returns its sequence; blocks while max_unacknowledged batches
+  // await their acks. The session's error once it has ended.
+  absl::StatusOr<uint64_t> Send(Scan scan);
+  // Waits until every batch sent so far is acknowledged (DEADLINE_EXCEEDED after `timeout`,
+  // naming how many are not), or the session's error.
+  absl::Status Flush(absl::Duration timeout = absl::InfiniteDuration());
+  // Flush, then ends the stream and the session's thread. Send fails afterwards.
+  absl::Status Close(absl::Duration timeout = absl::InfiniteDuration());
+
+  // The acks received since the last call, in sequence order (with collect_acks).
+  std::vector<IngestAck> TakeAcks();
+  IngestTotals totals() const;
+  // Batches sent but not acknowledged.
+  size_t unacknowledged() const;
+  uint64_t writer_id() const { return writer_id_; }
+  const std::string& map() const { return map_; }
+
+ private:
+  struct Pending {
+    uint64_t sequence;
+    std::shared_ptr<const v1::IngestRequest> request;
+    uint64_t sent_on = 0;  // the stream generation it was last written on; 0 = never
+  };
+  struct Stream {
+    std::unique_ptr<grpc::ClientContext> context;
+    std::unique_ptr<grpc::ClientReaderWriter<v1::IngestRequest, v1::IngestResponse>> rw;
+  };
+
+  IngestSession(std::shared_ptr<Connection> connection, std::string map, IngestOptions options, uint64_t writer_id);
+
+  // The background thread: opens streams, reads acks, reconnects.
+  void Run();
+  // Opens a stream and writes every pending batch on it. REQUIRES: write_mutex_ held.
+  std::shared_ptr<Stream> OpenStreamLocked();
+  // Writes, in order, the pending batches not yet written on the current stream. Stops at a failed
+  // write (the reader notices the broken stream). REQUIRES: write_mutex_ held.
+  void WriteUnsentLocked();
+  // The ack of the oldest pending batch from `response`; INTERNAL when it answers another batch.
+  // REQUIRES: mutex_ held.
+  absl::Status MatchLocked(const v1::IngestResponse& response, IngestAck& ack) const;
+  // The oldest pending batch is acknowledged: drop it, count it, keep the ack. REQUIRES: mutex_ held.
+  void RecordLocked(IngestAck ack);
+  // Ends the session with `error`. REQUIRES: mutex_ held.
+  void FailLocked(absl::Status error);
+
+  const std::shared_ptr<Connection> connection_;
+  const std::string map_;
+  const IngestOptions options_;
+  const uint64_t writer_id_;
+
+  // Held while writing to the stream and while replacing it; taken before mutex_, never after.
+  std::timed_mutex write_mutex_;
+  std::shared_ptr<Stream> stream_;  // written with both mutexes held, read with either
+  uint64_t generation_ = 0;         // guarded by both: written with both held, read with either
+
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Pending> pending_;
+  uint64_t next_sequence_;
+  std::vector<IngestAck> acks_;
+  IngestTotals totals_;
+  absl::Status error_;     // the session has ended with this
+  bool closing_ = false;   // Close: no more Send
+  bool stopping_ = false;  // destructor: leave now
+
+  std::thread thread_;
+};
+
+}  // namespace fremen::client
