@@ -2,15 +2,19 @@
 // subcommands and maps its outcome to the exit code: 0 success (or help), 1 the command failed
 // (e.g. bad input file), 2 bad usage.
 #include "CLI/CLI.hpp"
+#include "client/fremenctl/connection.h"
 #include "client/fremenctl/eval_command.h"
 #include "client/fremenctl/exit_codes.h"
+#include "client/fremenctl/maps_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app("fremenctl: the command line of the fremen FreMEn map database", "fremenctl");
   app.require_subcommand(1);
   app.footer("Run `fremenctl SUBCOMMAND --help` for a subcommand's options.\n"
              "Exit codes: 0 success, 1 the command failed, 2 bad usage.");
+  fremen::client::AddGlobalOptions(app);
   fremen::client::RegisterEvalCommand(app);
+  fremen::client::RegisterMapsCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
