@@ -64,4 +64,42 @@ absl::StatusOr<Point> ParsePointArg(absl::string_view text) {
   return Point{(*v)[0], (*v)[1], (*v)[2]};
 }
 
+absl::StatusOr<StateSet> ParseStateArgs(const StateArgs& args) {
+  const int kinds = !args.cells.empty() + !args.points.empty() + !args.ids.empty() + !args.names.empty();
+  if (kinds != 1) {
+    return absl::InvalidArgumentError(
+        "name the states with one of --cell X,Y[,Z], --point X,Y[,Z] (grid maps), --id N or --name S (generic "
+        "maps); each may repeat, but kinds cannot be mixed");
+  }
+  if (!args.ids.empty()) return StateSet::Ids(args.ids);
+  if (!args.names.empty()) return StateSet::Names(args.names);
+  if (!args.cells.empty()) {
+    std::vector<Cell> cells;
+    for (const std::string& text : args.cells) {
+      auto cell = ParseCellArg(text);
+      if (!cell.ok()) return cell.status();
+      cells.push_back(*cell);
+    }
+    return StateSet::Cells(cells);
+  }
+  std::vector<Point> points;
+  for (const std::string& text : args.points) {
+    auto point = ParsePointArg(text);
+    if (!point.ok()) return point.status();
+    points.push_back(*point);
+  }
+  return StateSet::Points(points);
+}
+
+absl::StatusOr<std::vector<double>> ParseTimeArgs(const std::vector<std::string>& texts, absl::Time now) {
+  if (texts.empty()) return absl::InvalidArgumentError("give at least one --time");
+  std::vector<double> times;
+  for (const std::string& text : texts) {
+    auto time = ParseTimeArg(text, now);
+    if (!time.ok()) return time.status();
+    times.push_back(*time);
+  }
+  return times;
+}
+
 }  // namespace fremen::client

@@ -3,7 +3,9 @@
 // expected. Thread-safety: pure functions.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -17,5 +19,15 @@ namespace fremen::client {
 absl::StatusOr<double> ParseTimeArg(absl::string_view text, absl::Time now = absl::Now());
 absl::StatusOr<Cell> ParseCellArg(absl::string_view text);
 absl::StatusOr<Point> ParsePointArg(absl::string_view text);
+
+// The states named on a command line: exactly one of the lists non-empty (--cell X,Y[,Z],
+// --point X,Y[,Z], --id N, --name S; each may repeat).
+struct StateArgs {
+  std::vector<std::string> cells, points, names;
+  std::vector<uint64_t> ids;
+};
+absl::StatusOr<StateSet> ParseStateArgs(const StateArgs& args);
+// The times named on a command line (ParseTimeArg each); at least one.
+absl::StatusOr<std::vector<double>> ParseTimeArgs(const std::vector<std::string>& texts, absl::Time now = absl::Now());
 
 }  // namespace fremen::client

@@ -41,6 +41,33 @@ TEST(CliArgsTest, PointsAreTwoOrThreeMetricCoordinates) {
   EXPECT_FALSE(ParsePointArg("1,inf").ok());
 }
 
+TEST(CliArgsTest, StatesAreOfOneKind) {
+  StateArgs cells;
+  cells.cells = {"1,2", "3,4,1"};
+  auto set = ParseStateArgs(cells);
+  ASSERT_TRUE(set.ok()) << set.status();
+  EXPECT_EQ(set->size(), 2u);
+  EXPECT_EQ(set->proto().cells().z(1), 1u);
+  StateArgs ids;
+  ids.ids = {7};
+  EXPECT_EQ(ParseStateArgs(ids)->proto().ids(0), 7u);
+  StateArgs mixed = cells;
+  mixed.names = {"door"};
+  EXPECT_THAT(ParseStateArgs(mixed).status().message(), HasSubstr("cannot be mixed"));
+  EXPECT_FALSE(ParseStateArgs(StateArgs{}).ok());
+  StateArgs bad;
+  bad.points = {"1"};
+  EXPECT_THAT(ParseStateArgs(bad).status().message(), HasSubstr("point \"1\""));
+}
+
+TEST(CliArgsTest, TimesAreAllParsed) {
+  auto times = ParseTimeArgs({"10", "now"}, absl::FromUnixSeconds(20));
+  ASSERT_TRUE(times.ok());
+  EXPECT_THAT(*times, ::testing::ElementsAre(10, 20));
+  EXPECT_FALSE(ParseTimeArgs({}).ok());
+  EXPECT_FALSE(ParseTimeArgs({"10", "soon"}).ok());
+}
+
 TEST(CliArgsTest, HintsSayWhatToFix) {
   EXPECT_THAT(HintFor(absl::NotFoundError("no map named \"x\""), "x", "h:1"), HasSubstr("fremenctl maps list"));
   EXPECT_EQ(HintFor(absl::NotFoundError("no operation named \"o\""), "x", "h:1"), "");

@@ -2,10 +2,13 @@
 // subcommands and maps its outcome to the exit code: 0 success (or help), 1 the command failed
 // (e.g. bad input file), 2 bad usage.
 #include "CLI/CLI.hpp"
+#include "client/fremenctl/admin_commands.h"
 #include "client/fremenctl/connection.h"
 #include "client/fremenctl/eval_command.h"
 #include "client/fremenctl/exit_codes.h"
 #include "client/fremenctl/maps_command.h"
+#include "client/fremenctl/query_commands.h"
+#include "client/fremenctl/update_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app("fremenctl: the command line of the fremen FreMEn map database", "fremenctl");
@@ -15,6 +18,14 @@ int main(int argc, char** argv) {
   fremen::client::AddGlobalOptions(app);
   fremen::client::RegisterEvalCommand(app);
   fremen::client::RegisterMapsCommand(app);
+  fremen::client::RegisterPredictCommand(app);
+  fremen::client::RegisterTopCommand(app);
+  fremen::client::RegisterAnomaliesCommand(app);
+  fremen::client::RegisterStatsCommand(app);
+  fremen::client::RegisterUpdateCommand(app);
+  fremen::client::RegisterBackupCommand(app);
+  fremen::client::RegisterRestoreCommand(app);
+  fremen::client::RegisterStatusCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

@@ -46,7 +46,7 @@ std::string KindName(v1::MapKind kind) {
 std::string Shape(const v1::Map& map) {
   if (map.kind() != v1::MAP_KIND_GRID) return KindName(map.kind());
   const v1::GridGeometry& g = map.grid();
-  return absl::StrFormat("grid %u×%u×%u cells of %g m", g.size().x(), g.size().y(), std::max(1u, g.size().z()),
+  return absl::StrFormat("grid %ux%ux%u cells of %g m", g.size().x(), g.size().y(), std::max(1u, g.size().z()),
                          g.resolution());
 }
 
