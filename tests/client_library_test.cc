@@ -459,6 +459,30 @@ TEST(ClientConnectionTest, IdempotentCallsRetryUntilTheDaemonComesUp) {
   EXPECT_EQ((*daemon)->Stop(), 0);
 }
 
+TEST(ClientConnectionTest, TlsWithTheDaemonsRootCertificate) {
+  TempDir dir;
+  const std::optional<TestCertificate> certificate = MakeTestCertificate(dir);
+  if (!certificate) GTEST_SKIP() << "openssl cannot make a test certificate";
+  grpc::SslCredentialsOptions ssl;
+  ssl.pem_root_certs = certificate->cert_pem;
+  auto daemon = FremendProcess::Start(
+      dir.Path("data"), {"--tls-cert-file", certificate->cert_path, "--tls-key-file", certificate->key_path},
+      grpc::SslCredentials(ssl));
+  ASSERT_TRUE(daemon.ok()) << daemon.status();
+  ConnectionOptions options;
+  options.address = (*daemon)->address();
+  options.tls_root_certs_pem = certificate->cert_pem;
+  auto status = Client::Connect(options)->GetServerStatus();
+  ASSERT_TRUE(status.ok()) << status.status();
+  EXPECT_TRUE(status->tls());
+  // Without TLS the daemon is not reachable: the handshake fails.
+  options.tls_root_certs_pem.clear();
+  options.retry.max_attempts = 1;
+  EXPECT_EQ(Client::Connect(options)->GetServerStatus({.timeout = absl::Seconds(5)}).status().code(),
+            absl::StatusCode::kUnavailable);
+  EXPECT_EQ((*daemon)->Stop(), 0);
+}
+
 class ClientTokenTest : public DaemonTest {
  protected:
   void SetUp() override {

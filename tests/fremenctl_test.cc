@@ -367,6 +367,28 @@ TEST_F(FremenctlTest, UnreachableDaemonSaysToStartItOrFixTheAddress) {
   EXPECT_THAT(ca.err, HasSubstr("--tls-ca"));
 }
 
+class FremenctlTlsTest : public FremenctlTest {
+ protected:
+  void SetUp() override {
+    certificate_ = MakeTestCertificate(dir_);
+    if (!certificate_) GTEST_SKIP() << "openssl cannot make a test certificate";
+    grpc::SslCredentialsOptions ssl;
+    ssl.pem_root_certs = certificate_->cert_pem;
+    StartDaemon({"--tls-cert-file", certificate_->cert_path, "--tls-key-file", certificate_->key_path},
+                grpc::SslCredentials(ssl));
+  }
+  std::optional<TestCertificate> certificate_;
+};
+
+TEST_F(FremenctlTlsTest, TlsCaConnectsWithTls) {
+  Result r = Run("status --tls-ca '" + certificate_->cert_path + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("security: TLS"));
+  Result plain = Run("status --timeout 5");
+  EXPECT_EQ(plain.exit_code, 1);
+  EXPECT_THAT(plain.err, HasSubstr("is fremend running at"));
+}
+
 class FremenctlTokenTest : public FremenctlTest {
  protected:
   void SetUp() override { StartDaemon({"--tokens", "read:reader-token write:writer-token"}); }

@@ -98,6 +98,16 @@ std::string FreeLoopbackAddress() {
   return absl::StrCat("127.0.0.1:", ntohs(address.sin_port));
 }
 
+std::optional<TestCertificate> MakeTestCertificate(const TempDir& dir) {
+  TestCertificate made{dir.Path("cert.pem"), dir.Path("key.pem"), ""};
+  const std::string openssl = "openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 1"
+                              " -subj /CN=localhost -addext subjectAltName=IP:127.0.0.1,DNS:localhost"
+                              " -keyout '" + made.key_path + "' -out '" + made.cert_path + "' >/dev/null 2>&1";
+  if (std::system(openssl.c_str()) != 0) return std::nullopt;
+  made.cert_pem = ReadFile(made.cert_path);
+  return made;
+}
+
 RunResult RunFremend(const std::vector<std::string>& args) {
   TempDir dir;
   const std::string log_path = dir.Path("output");

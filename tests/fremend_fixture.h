@@ -54,6 +54,14 @@ struct RunResult {
 // on the same address after a restart.
 std::string FreeLoopbackAddress();
 
+// A self-signed certificate for 127.0.0.1 and localhost, made with the openssl command line into
+// `dir` (cert.pem, key.pem). nullopt when openssl cannot make one (the test then skips).
+struct TestCertificate {
+  std::string cert_path, key_path;
+  std::string cert_pem;  // the certificate itself: the root a client trusts
+};
+std::optional<TestCertificate> MakeTestCertificate(const TempDir& dir);
+
 // Runs fremend with `args` to completion (help, bad configuration, --check-config).
 RunResult RunFremend(const std::vector<std::string>& args);
 

@@ -239,16 +239,12 @@ TEST_F(FremendTokenTest, HealthNeedsNoToken) {
 
 TEST(FremendTlsTest, ServesTlsAndRefusesPlaintext) {
   TempDir dir;
-  const std::string cert = dir.Path("cert.pem");
-  const std::string key = dir.Path("key.pem");
-  const std::string openssl = "openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 1"
-                              " -subj /CN=localhost -addext subjectAltName=IP:127.0.0.1,DNS:localhost"
-                              " -keyout '" + key + "' -out '" + cert + "' >/dev/null 2>&1";
-  if (std::system(openssl.c_str()) != 0) GTEST_SKIP() << "openssl cannot make a test certificate";
+  const std::optional<TestCertificate> certificate = MakeTestCertificate(dir);
+  if (!certificate) GTEST_SKIP() << "openssl cannot make a test certificate";
   grpc::SslCredentialsOptions options;
-  std::ifstream in(cert);
-  options.pem_root_certs.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  auto started = FremendProcess::Start(dir.Path("data"), {"--tls-cert-file", cert, "--tls-key-file", key},
+  options.pem_root_certs = certificate->cert_pem;
+  auto started = FremendProcess::Start(dir.Path("data"),
+                                       {"--tls-cert-file", certificate->cert_path, "--tls-key-file", certificate->key_path},
                                        grpc::SslCredentials(options));
   ASSERT_TRUE(started.ok()) << started.status();
   auto& daemon = *started;
