@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <thread>
 
 #include "absl/time/clock.h"
 #include "client/lib/client.h"
@@ -100,6 +101,44 @@ TEST_F(ClientIngestResumeTest, EveryBatchIsAppliedExactlyOnceAcrossRestartsAndAK
     ASSERT_TRUE(model->has_value()) << "state " << id;
     EXPECT_EQ((*model)->observations(), kBatches) << "state " << id << " lost or repeated batches";
     EXPECT_DOUBLE_EQ((*model)->last_time(), kStart + 60.0 * (kBatches - 1));
+  }
+  auto stats = client_->GetMapStats("doors");
+  ASSERT_TRUE(stats.ok()) << stats.status();
+  EXPECT_EQ(stats->observations(), kBatches * kStates);
+}
+
+TEST_F(ClientIngestResumeTest, ASenderThreadKeepsSendingThroughAKillAndARestart) {
+  // Here the batches come from another thread while this one kills and restarts the daemon: Send
+  // blocks during the outage (the window is full) and resumes once the session has reconnected.
+  client::IngestOptions options;
+  options.max_unacknowledged = 16;
+  options.collect_acks = false;
+  auto session = client_->OpenIngest("doors", options);
+  ASSERT_TRUE(session.ok()) << session.status();
+  constexpr int kBatches = 4 * kBatchesPerPhase;
+  std::thread sender([&] { SendBatches(**session, 0, kBatches); });
+  const auto await_acks = [&](uint64_t n) {
+    const absl::Time give_up = absl::Now() + absl::Seconds(120);
+    while ((*session)->totals().acknowledged < n && absl::Now() < give_up) absl::SleepFor(absl::Milliseconds(1));
+  };
+  await_acks(kBatches / 4);
+  daemon_->Kill();
+  daemon_.reset();
+  StartDaemon({"--listen", address_});
+  await_acks(kBatches / 2);
+  StopDaemon();
+  StartDaemon({"--listen", address_});
+  sender.join();
+  ASSERT_FALSE(HasFatalFailure());
+  ASSERT_TRUE((*session)->Close(absl::Seconds(120)).ok());
+
+  const auto totals = (*session)->totals();
+  EXPECT_EQ(totals.acknowledged, static_cast<uint64_t>(kBatches));
+  EXPECT_GE(totals.reconnects, 2u);
+  for (uint64_t id = 1; id <= kStates; ++id) {
+    auto model = client_->GetStateModel("doors", State::WithId(id));
+    ASSERT_TRUE(model.ok() && model->has_value()) << "state " << id;
+    EXPECT_EQ((*model)->observations(), static_cast<uint64_t>(kBatches)) << "state " << id;
   }
   auto stats = client_->GetMapStats("doors");
   ASSERT_TRUE(stats.ok()) << stats.status();
