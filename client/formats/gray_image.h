@@ -19,7 +19,9 @@ struct Image {
   Image() = default;
   Image(int w, int h, int c, uint8_t fill = 0)
       : width(w), height(h), channels(c), pixels(static_cast<size_t>(w) * h * c, fill) {}
-  uint8_t& at(int x, int y, int channel = 0) { return pixels[(static_cast<size_t>(y) * width + x) * channels + channel]; }
+  uint8_t& at(int x, int y, int channel = 0) {
+    return pixels[(static_cast<size_t>(y) * width + x) * channels + channel];
+  }
   uint8_t at(int x, int y, int channel = 0) const {
     return pixels[(static_cast<size_t>(y) * width + x) * channels + channel];
   }

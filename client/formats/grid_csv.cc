@@ -45,7 +45,8 @@ bool ParseIndex(std::string_view token, uint32_t& value) {
 }
 
 absl::Status FieldError(const std::string& field, const std::string& what, std::string_view got) {
-  return absl::InvalidArgumentError(absl::StrCat("field ", field, ": expected ", what, ", got \"", std::string(got), "\""));
+  return absl::InvalidArgumentError(
+      absl::StrCat("field ", field, ": expected ", what, ", got \"", std::string(got), "\""));
 }
 
 // Parses the fields of one data line (4 or 5 of them) into `o`.

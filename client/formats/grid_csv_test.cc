@@ -16,7 +16,8 @@ absl::StatusOr<std::vector<CellObservation>> Parse(const std::string& text) {
 }
 
 TEST(GridCsvTest, ReadsTwoDimensionalRowsWithHeaderAndComments) {
-  absl::StatusOr<std::vector<CellObservation>> rows = Parse("time,x,y,state\n# scan 1\n100,1,2,1\n\n100, 3 ,4,0.25\r\n");
+  absl::StatusOr<std::vector<CellObservation>> rows =
+      Parse("time,x,y,state\n# scan 1\n100,1,2,1\n\n100, 3 ,4,0.25\r\n");
   ASSERT_TRUE(rows.ok()) << rows.status();
   ASSERT_EQ(rows->size(), 2u);
   EXPECT_EQ((*rows)[1].t, 100);
@@ -37,11 +38,13 @@ TEST(GridCsvTest, ReadsThreeDimensionalRowsWithoutHeader) {
 TEST(GridCsvTest, ErrorsNameFileLineAndField) {
   EXPECT_EQ(Parse("time,x,y,state\n1,-1,2,1\n").status().message(),
             "grid.csv:2: field x: expected a cell index (an integer in [0, 4294967295]), got \"-1\"");
-  EXPECT_EQ(Parse("1,1,2,1.5\n").status().message(), "grid.csv:1: field state: expected a number in [0, 1], got \"1.5\"");
+  EXPECT_EQ(Parse("1,1,2,1.5\n").status().message(),
+            "grid.csv:1: field state: expected a number in [0, 1], got \"1.5\"");
   EXPECT_THAT(Parse("nan,1,2,1\n").status().message(), HasSubstr("grid.csv:1: field time"));
   EXPECT_THAT(Parse("1,1,2,z,1\n").status().message(), HasSubstr("grid.csv:1: field z"));
   EXPECT_THAT(Parse("1,1,2\n").status().message(), HasSubstr("grid.csv:1: expected 4 fields"));
-  EXPECT_THAT(Parse("1,1,2,1\n2,1,2,3,1\n").status().message(), HasSubstr("grid.csv:2: expected 4 fields as on the lines before"));
+  EXPECT_THAT(Parse("1,1,2,1\n2,1,2,3,1\n").status().message(),
+              HasSubstr("grid.csv:2: expected 4 fields as on the lines before"));
   EXPECT_THAT(Parse("time,x,y,state\n2,1,2,3,1\n").status().message(), HasSubstr("grid.csv:2: expected 4 fields"));
   EXPECT_THAT(Parse("time,y,x,state\n").status().message(), HasSubstr("grid.csv:1: the header must be"));
   EXPECT_EQ(Parse("# nothing\n").status().message(), "grid.csv: no observations");

@@ -43,9 +43,8 @@ absl::StatusOr<std::vector<SnapshotFile>> ReadTimesFile(const std::string& direc
           absl::StrCat(times_path, ":", number, ": expected `FILE.yaml TIME`, got \"", line, "\""));
     }
     if (!ParseTime(time_text, time)) {
-      return absl::InvalidArgumentError(absl::StrCat(times_path, ":", number,
-                                                     ": TIME must be a finite number of seconds within ±1e13, got \"",
-                                                     time_text, "\""));
+      return absl::InvalidArgumentError(absl::StrCat(
+          times_path, ":", number, ": TIME must be a finite number of seconds within ±1e13, got \"", time_text, "\""));
     }
     const fs::path path = fs::path(name).is_absolute() ? fs::path(name) : fs::path(directory) / name;
     if (!fs::is_regular_file(path)) {
@@ -80,9 +79,10 @@ absl::StatusOr<double> TimeFromFileName(const std::string& path) {
   if (begin == 1 && stem[0] == '-') begin = 0;
   double time;
   if (begin == stem.size() || !ParseTime(std::string_view(stem).substr(begin), time)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        path, ": the file name does not end with its time in seconds (e.g. office_1700000000.yaml); rename the "
-              "files or list `FILE.yaml TIME` lines in a --times file"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(path,
+                     ": the file name does not end with its time in seconds (e.g. office_1700000000.yaml); rename the "
+                     "files or list `FILE.yaml TIME` lines in a --times file"));
   }
   return time;
 }
@@ -101,7 +101,8 @@ absl::StatusOr<std::vector<SnapshotFile>> ListSnapshots(const std::string& direc
     std::vector<std::string> paths;
     for (const fs::directory_entry& entry : fs::directory_iterator(directory, error)) {
       const std::string extension = entry.path().extension().string();
-      if (entry.is_regular_file() && (extension == ".yaml" || extension == ".yml")) paths.push_back(entry.path().string());
+      if (entry.is_regular_file() && (extension == ".yaml" || extension == ".yml"))
+        paths.push_back(entry.path().string());
     }
     if (error) return absl::NotFoundError(absl::StrCat(directory, ": cannot list: ", error.message()));
     std::sort(paths.begin(), paths.end());
@@ -115,7 +116,8 @@ absl::StatusOr<std::vector<SnapshotFile>> ListSnapshots(const std::string& direc
     return absl::InvalidArgumentError(
         absl::StrCat(times_path.empty() ? directory : times_path, ": no map_server snapshots (*.yaml) to import"));
   }
-  std::stable_sort(files.begin(), files.end(), [](const SnapshotFile& a, const SnapshotFile& b) { return a.time < b.time; });
+  std::stable_sort(files.begin(), files.end(),
+                   [](const SnapshotFile& a, const SnapshotFile& b) { return a.time < b.time; });
   return files;
 }
 
@@ -135,8 +137,8 @@ absl::Status PlaceSnapshot(const Snapshot& snapshot, const GridPlacement& grid, 
                            uint32_t& offset_x, uint32_t& offset_y) {
   const MapMetadata& m = snapshot.metadata;
   if (std::fabs(m.resolution - grid.resolution) > 1e-9 * grid.resolution) {
-    return absl::InvalidArgumentError(absl::StrCat(name, ": resolution ", m.resolution,
-                                                   " differs from the map's grid resolution ", grid.resolution));
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, ": resolution ", m.resolution, " differs from the map's grid resolution ", grid.resolution));
   }
   // Cell offsets of the snapshot's corner; it must sit on a cell corner (within a thousandth of a
   // cell, the precision of a YAML written with a few decimals).
@@ -144,15 +146,14 @@ absl::Status PlaceSnapshot(const Snapshot& snapshot, const GridPlacement& grid, 
   const double fy = (m.origin_y - grid.origin_y) / grid.resolution;
   const double rx = std::round(fx), ry = std::round(fy);
   if (std::fabs(fx - rx) > 1e-3 || std::fabs(fy - ry) > 1e-3) {
-    return absl::InvalidArgumentError(absl::StrCat(name, ": origin (", m.origin_x, ", ", m.origin_y,
-                                                   ") is not on a cell corner of the map's grid (origin (",
-                                                   grid.origin_x, ", ", grid.origin_y, "), resolution ",
-                                                   grid.resolution, ")"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        name, ": origin (", m.origin_x, ", ", m.origin_y, ") is not on a cell corner of the map's grid (origin (",
+        grid.origin_x, ", ", grid.origin_y, "), resolution ", grid.resolution, ")"));
   }
   if (rx < 0 || ry < 0 || rx + snapshot.image.width > grid.size_x || ry + snapshot.image.height > grid.size_y) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(name, ": the ", snapshot.image.width, "x", snapshot.image.height, " image at cell (", rx, ", ", ry,
-                     ") does not lie inside the map's ", grid.size_x, "x", grid.size_y, " grid"));
+    return absl::InvalidArgumentError(absl::StrCat(name, ": the ", snapshot.image.width, "x", snapshot.image.height,
+                                                   " image at cell (", rx, ", ", ry, ") does not lie inside the map's ",
+                                                   grid.size_x, "x", grid.size_y, " grid"));
   }
   offset_x = static_cast<uint32_t>(rx);
   offset_y = static_cast<uint32_t>(ry);

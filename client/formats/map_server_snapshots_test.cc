@@ -133,9 +133,9 @@ TEST_F(SnapshotDirTest, ExportedRegionReadsBackAsTheSameCells) {
   EXPECT_EQ(batches[0].values, (std::vector<float>{1, 0, 0, 1}));
   absl::StatusOr<Image> png = ReadPng(prefix + ".png");
   ASSERT_TRUE(png.ok()) << png.status();
-  EXPECT_EQ(png->at(0, 0), 0);     // p = 1 at (0, 1): black
-  EXPECT_EQ(png->at(2, 1), 128);   // p = 0.5 at (2, 0)
-  EXPECT_EQ(png->at(0, 1), 255);   // p = 0 at (0, 0): white
+  EXPECT_EQ(png->at(0, 0), 0);    // p = 1 at (0, 1): black
+  EXPECT_EQ(png->at(2, 1), 128);  // p = 0.5 at (2, 0)
+  EXPECT_EQ(png->at(0, 1), 255);  // p = 0 at (0, 0): white
 }
 
 }  // namespace

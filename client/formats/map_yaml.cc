@@ -107,7 +107,8 @@ class Parser {
   absl::Status Number(const std::string& key, double& value, bool required) const {
     const Entry* entry = Find(key);
     if (entry == nullptr) return required ? Error(key, "is missing (a number is required)") : absl::OkStatus();
-    if (!ParseNumber(entry->value, value)) return Error(key, absl::StrCat("must be a number, got \"", entry->value, "\""));
+    if (!ParseNumber(entry->value, value))
+      return Error(key, absl::StrCat("must be a number, got \"", entry->value, "\""));
     return absl::OkStatus();
   }
 
@@ -130,7 +131,8 @@ absl::StatusOr<MapMetadata> ParseMapYaml(const std::string& text, const std::str
   m.image = std::string(Unquote(image->value));
 
   if (absl::Status s = parser.Number("resolution", m.resolution, true); !s.ok()) return s;
-  if (!(m.resolution > 0)) return parser.Error("resolution", absl::StrCat("must be > 0 metres per pixel, got ", m.resolution));
+  if (!(m.resolution > 0))
+    return parser.Error("resolution", absl::StrCat("must be > 0 metres per pixel, got ", m.resolution));
 
   const Entry* origin = parser.Find("origin");
   if (origin == nullptr) return parser.Error("origin", "is missing ([x, y, yaw] is required)");
@@ -174,8 +176,8 @@ absl::StatusOr<MapMetadata> ParseMapYaml(const std::string& text, const std::str
   if (!(m.occupied_thresh <= 1.0)) return parser.Error("occupied_thresh", "must be at most 1");
   if (!(m.free_thresh >= 0.0)) return parser.Error("free_thresh", "must be at least 0");
   if (!(m.free_thresh < m.occupied_thresh)) {
-    return parser.Error("free_thresh", absl::StrCat("must be below occupied_thresh (", m.occupied_thresh, "), got ",
-                                                    m.free_thresh));
+    return parser.Error("free_thresh",
+                        absl::StrCat("must be below occupied_thresh (", m.occupied_thresh, "), got ", m.free_thresh));
   }
   if (const Entry* mode = parser.Find("mode"); mode != nullptr) {
     const std::string_view v = Unquote(mode->value);
@@ -184,7 +186,8 @@ absl::StatusOr<MapMetadata> ParseMapYaml(const std::string& text, const std::str
     } else if (v == "scale") {
       m.mode = MapMode::kScale;
     } else {
-      return parser.Error("mode", absl::StrCat("must be trinary or scale (raw is not supported), got \"", mode->value, "\""));
+      return parser.Error("mode",
+                          absl::StrCat("must be trinary or scale (raw is not supported), got \"", mode->value, "\""));
     }
   }
   return m;

@@ -61,9 +61,8 @@ TEST(MapYamlTest, ErrorsNameTheFileLineAndKey) {
               HasSubstr("m.yaml:3: origin must be [x, y, yaw]"));
   EXPECT_THAT(ParseMapYaml("resolution: 1\norigin: [0, 0, 0]\n", "m.yaml").status().message(),
               HasSubstr("m.yaml: image is missing"));
-  EXPECT_THAT(
-      ParseMapYaml("image: a\nresolution: 1\norigin: [0,0,0]\nfree_thresh: 0.7\n", "m.yaml").status().message(),
-      HasSubstr("m.yaml:4: free_thresh must be below occupied_thresh"));
+  EXPECT_THAT(ParseMapYaml("image: a\nresolution: 1\norigin: [0,0,0]\nfree_thresh: 0.7\n", "m.yaml").status().message(),
+              HasSubstr("m.yaml:4: free_thresh must be below occupied_thresh"));
   EXPECT_THAT(ParseMapYaml("image: a\nresolution: 1\norigin: [0,0,0]\nmode: raw\n", "m.yaml").status().message(),
               HasSubstr("m.yaml:4: mode must be trinary or scale"));
   EXPECT_THAT(ParseMapYaml("image: a\nresolution: 1\nresolution: 2\n", "m.yaml").status().message(),

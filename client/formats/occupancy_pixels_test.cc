@@ -59,7 +59,7 @@ TEST(OccupancyPixelsTest, ExportWritesMapSaverPixelsThatReadBackTheSame) {
   EXPECT_EQ(PixelFromProbability(0.65, m), kPixelOccupied);  // cell 65 ≥ 65
   EXPECT_EQ(PixelFromProbability(0.64, m), kPixelUnknown);
   EXPECT_EQ(PixelFromProbability(0.5, m), kPixelUnknown);  // never observed
-  EXPECT_EQ(PixelFromProbability(0.2, m), kPixelFree);    // cell 20 ≤ rint(19.6)
+  EXPECT_EQ(PixelFromProbability(0.2, m), kPixelFree);     // cell 20 ≤ rint(19.6)
   EXPECT_EQ(PixelFromProbability(0.0, m), kPixelFree);
   EXPECT_EQ(PixelFromProbability(-3, m), kPixelFree);  // clamped
   for (double p : {0.0, 0.1, 0.5, 0.9, 1.0}) {

@@ -34,7 +34,7 @@ struct Desk {
   uint32_t x, y;
   double arrive_hour, leave_hour;
 };
-constexpr Desk kDesks[] = {{5, 4, 8.5, 17.0}, {9, 4, 9.0, 18.0}, {5, 15, 8.0, 16.5},
+constexpr Desk kDesks[] = {{5, 4, 8.5, 17.0},   {9, 4, 9.0, 18.0},  {5, 15, 8.0, 16.5},
                            {9, 15, 10.0, 19.0}, {30, 5, 8.5, 17.5}, {34, 14, 9.5, 18.5}};
 
 // One day's plan, drawn once a day so that a day's behaviour is consistent.

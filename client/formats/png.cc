@@ -60,11 +60,11 @@ absl::StatusOr<std::string> EncodePng(const Image& image) {
   std::string header;
   AppendBigEndian32(header, static_cast<uint32_t>(image.width));
   AppendBigEndian32(header, static_cast<uint32_t>(image.height));
-  header.push_back(8);                                // bit depth
-  header.push_back(image.channels == 1 ? 0 : 2);      // colour type: gray or RGB
-  header.push_back(0);                                // compression: deflate
-  header.push_back(0);                                // filter method 0
-  header.push_back(0);                                // no interlace
+  header.push_back(8);                            // bit depth
+  header.push_back(image.channels == 1 ? 0 : 2);  // colour type: gray or RGB
+  header.push_back(0);                            // compression: deflate
+  header.push_back(0);                            // filter method 0
+  header.push_back(0);                            // no interlace
 
   std::string png("\x89PNG\r\n\x1a\n", 8);
   AppendChunk(png, "IHDR", header);

@@ -61,16 +61,16 @@ TEST(PngTest, DecoderUndoesEveryRowFilter) {
   // Rows filtered with Sub, Up, Average and Paeth by hand: a 2 × 4 gray image.
   const uint8_t pixels[4][2] = {{10, 20}, {30, 50}, {70, 71}, {5, 250}};
   std::string raw;
-  raw += std::string{1, 10, static_cast<char>(20 - 10)};                                  // Sub
-  raw += std::string{2, static_cast<char>(30 - 10), static_cast<char>(50 - 20)};         // Up
+  raw += std::string{1, 10, static_cast<char>(20 - 10)};                                         // Sub
+  raw += std::string{2, static_cast<char>(30 - 10), static_cast<char>(50 - 20)};                 // Up
   raw += std::string{3, static_cast<char>(70 - 30 / 2), static_cast<char>(71 - (70 + 50) / 2)};  // Average
   // Paeth row 3: first byte predictor = b (above 70); second: a=5, b=71, c=70 → p=6, nearest a.
   raw += std::string{4, static_cast<char>(5 - 70), static_cast<char>(250 - 5)};
   uLongf size = compressBound(raw.size());
   std::string idat(size, '\0');
-  ASSERT_EQ(compress(reinterpret_cast<Bytef*>(idat.data()), &size, reinterpret_cast<const Bytef*>(raw.data()),
-                     raw.size()),
-            Z_OK);
+  ASSERT_EQ(
+      compress(reinterpret_cast<Bytef*>(idat.data()), &size, reinterpret_cast<const Bytef*>(raw.data()), raw.size()),
+      Z_OK);
   idat.resize(size);
   // Reuse the encoder's framing: encode an image of the same size, then swap its IDAT.
   absl::StatusOr<std::string> frame = EncodePng(Image(2, 4, 1));

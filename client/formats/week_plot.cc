@@ -58,7 +58,8 @@ std::string RenderSvg(const TimeSeriesPlot& plot, const PlotLayout& l) {
       "<rect x=\"0\" y=\"0\" width=\"%d\" height=\"%d\" fill=\"white\"/>\n",
       l.width, l.height, l.width, l.height, l.width, l.height);
   absl::StrAppend(&svg, "<title>", EscapeXml(plot.title), "</title>\n");
-  absl::StrAppend(&svg, absl::StrFormat("<text x=\"%d\" y=\"%d\">%s</text>\n", l.left, l.top - 10, EscapeXml(plot.title)));
+  absl::StrAppend(&svg,
+                  absl::StrFormat("<text x=\"%d\" y=\"%d\">%s</text>\n", l.left, l.top - 10, EscapeXml(plot.title)));
 
   // Frame, the p = 0, 0.5 and 1 levels, and the day lines.
   const double x0 = l.X(plot, plot.start), x1 = l.X(plot, plot.end);
@@ -83,8 +84,9 @@ std::string RenderSvg(const TimeSeriesPlot& plot, const PlotLayout& l) {
   // Observations under the curve.
   for (const PlotPoint& o : plot.observations) {
     if (!Inside(plot, o.t)) continue;
-    absl::StrAppend(&svg, absl::StrFormat("<circle class=\"observation\" cx=\"%.1f\" cy=\"%.1f\" r=\"2\" fill=\"%s\"/>\n",
-                                          l.X(plot, o.t), l.Y(o.value), SvgColor(kObservationColor)));
+    absl::StrAppend(&svg,
+                    absl::StrFormat("<circle class=\"observation\" cx=\"%.1f\" cy=\"%.1f\" r=\"2\" fill=\"%s\"/>\n",
+                                    l.X(plot, o.t), l.Y(o.value), SvgColor(kObservationColor)));
   }
   if (Inside(plot, plot.last_observation)) {
     const double x = l.X(plot, plot.last_observation);

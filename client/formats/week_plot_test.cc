@@ -24,7 +24,8 @@ TimeSeriesPlot DailyWave() {
     const double t = plot.start + h * 3600.0;
     plot.probability.push_back({t, 0.5 + 0.4 * std::sin(2 * M_PI * h / 24.0)});
   }
-  for (int i = 0; i < 28; ++i) plot.observations.push_back({plot.start + i * 6 * 3600.0 + 1800, i % 2 == 0 ? 1.0 : 0.0});
+  for (int i = 0; i < 28; ++i)
+    plot.observations.push_back({plot.start + i * 6 * 3600.0 + 1800, i % 2 == 0 ? 1.0 : 0.0});
   plot.observations.push_back({plot.end + 10, 1.0});  // outside: not drawn
   plot.last_observation = plot.start + 3 * kDay;
   return plot;
