@@ -19,7 +19,8 @@ namespace {
 // of the line) and, for P2, the pixel values.
 class TokenReader {
  public:
-  explicit TokenReader(const std::string& bytes) : bytes_(bytes) {}
+  // Reads from `start` on (after the magic number).
+  TokenReader(const std::string& bytes, size_t start) : bytes_(bytes), pos_(start) {}
 
   // The next unsigned integer; false at the end or on a non-digit.
   bool NextNumber(long& value) {
@@ -54,7 +55,7 @@ class TokenReader {
   }
 
   const std::string& bytes_;
-  size_t pos_ = 0;
+  size_t pos_;
 };
 
 uint8_t Rescale(long value, long maxval) {
@@ -68,10 +69,7 @@ absl::StatusOr<Image> ParsePgm(const std::string& bytes, const std::string& name
     return absl::InvalidArgumentError(absl::StrCat(name, ": not a PGM file (the magic number must be P5 or P2)"));
   }
   const bool binary = bytes[1] == '5';
-  // Skip the magic: the reader starts with numbers.
-  std::string rest = bytes;
-  rest[0] = rest[1] = ' ';
-  TokenReader header(rest);
+  TokenReader header(bytes, 2);
   long width, height, maxval;
   if (!header.NextNumber(width) || width < 1 || width > 100'000) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": bad PGM header: width must be in [1, 100000]"));
@@ -90,12 +88,12 @@ absl::StatusOr<Image> ParsePgm(const std::string& bytes, const std::string& name
     }
     const size_t bytes_per_value = maxval < 256 ? 1 : 2;
     const size_t begin = header.pos();
-    if (rest.size() - begin < count * bytes_per_value) {
+    if (bytes.size() - begin < count * bytes_per_value) {
       return absl::InvalidArgumentError(absl::StrCat(name, ": truncated PGM data: expected ", count * bytes_per_value,
-                                                     " bytes of pixels, found ", rest.size() - begin));
+                                                     " bytes of pixels, found ", bytes.size() - begin));
     }
     for (size_t i = 0; i < count; ++i) {
-      const unsigned char* p = reinterpret_cast<const unsigned char*>(rest.data() + begin + i * bytes_per_value);
+      const unsigned char* p = reinterpret_cast<const unsigned char*>(bytes.data() + begin + i * bytes_per_value);
       // 16-bit samples are big-endian (Netpbm).
       const long value = bytes_per_value == 1 ? p[0] : (p[0] << 8) | p[1];
       if (value > maxval) {
