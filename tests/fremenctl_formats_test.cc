@@ -361,6 +361,23 @@ TEST_F(FremenctlFormatsTest, BadInputsSayWhatToFix) {
   r = Run({"ingest", "--map", "office", "--map-server", snapshots, "--create"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.err, HasSubstr("map_5.yaml: resolution is missing"));
+  // A snapshot that does not fit the grid of the first: nothing is sent and no empty map is left
+  // behind, since every file is checked before the map is created.
+  const std::string mixed = dir_.Path("mixed");
+  std::filesystem::create_directory(mixed);
+  WriteSnapshot(mixed, "office_1", StaticOffice());
+  WriteSnapshot(mixed, "office_2", StaticOffice());
+  std::ofstream(mixed + "/office_2.yaml") << "image: office_2.pgm\nresolution: 0.1\norigin: [-1, 2, 0]\n";
+  r = Run({"ingest", "--map", "office", "--map-server", mixed, "--create"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("office_2.yaml: resolution 0.1 differs from the map's grid resolution 0.05"));
+  {
+    auto maps = v1::MapService::NewStub(daemon_->NewChannel());
+    v1::GetMapRequest request;
+    request.set_map("office");
+    v1::GetMapResponse response;
+    EXPECT_EQ(maps->GetMap(CallContext().get(), request, &response).error_code(), grpc::StatusCode::NOT_FOUND);
+  }
   // ingest into a map that does not exist, without --create.
   r = Run({"ingest", "--map", "nomap", "--states", WriteDoorFile("d.txt", 1), "--name", "door"});
   EXPECT_EQ(r.exit_code, 1);

@@ -116,7 +116,7 @@ void RunDemo(const DemoArgs& args) {
       "  fremenctl region --map %s --time %s --out night\n"
       "      the same at 03:00: the door is closed (its doorway cells at x = %u are occupied)\n"
       "  fremenctl model --map %s --cell %u,%u\n"
-      "      the doorway cell's model, with its daily and weekly periods\n",
+      "      the doorway cell's model: its periods, the error of each order, persistence\n",
       states.c_str(), states.c_str(), Rfc3339(morning).c_str(), Rfc3339(afternoon).c_str(), office.c_str(),
       Rfc3339(morning).c_str(), office.c_str(), Rfc3339(night).c_str(), formats::kDoorX, office.c_str(),
       formats::kDoorX, formats::kDoorY0);

@@ -101,41 +101,59 @@ void IngestCsv(const Client& client, const IngestArgs& args) {
               MapWriter::Summary(totals, writer.first_rejections()).c_str());
 }
 
+// Two passes over the snapshots, so that memory holds one image at a time: the first reads and
+// checks every file against the map's grid (a bad file must not leave half a directory behind,
+// nor an empty new map), the second reads them again and sends them.
 void IngestMapServer(const Client& client, const IngestArgs& args) {
   absl::StatusOr<std::vector<formats::SnapshotFile>> files =
       formats::ListSnapshots(args.map_server_dir, args.times_file);
   if (!files.ok()) FailInput(kCommand, files.status());
-  // The first snapshot gives the geometry of a map created here; every snapshot is read (and
-  // checked) before anything is sent, so that a bad file does not leave half a directory behind.
-  std::vector<formats::Snapshot> snapshots;
-  for (const formats::SnapshotFile& file : *files) {
-    absl::StatusOr<formats::Snapshot> snapshot = formats::ReadSnapshot(file.yaml_path);
+  const auto read = [&](size_t i) {
+    absl::StatusOr<formats::Snapshot> snapshot = formats::ReadSnapshot((*files)[i].yaml_path);
     if (!snapshot.ok()) FailInput(kCommand, snapshot.status());
-    snapshots.push_back(*std::move(snapshot));
+    return *std::move(snapshot);
+  };
+
+  // The map's grid, or the first snapshot's for a map --create makes.
+  v1::Map map;
+  absl::StatusOr<v1::Map> existing = client.GetMap(args.map, GlobalCall());
+  if (existing.ok()) {
+    map = *existing;
+  } else if (existing.status().code() == absl::StatusCode::kNotFound && args.create) {
+    const formats::Snapshot first = read(0);
+    map = NewMap(args.map, v1::MAP_KIND_GRID);
+    v1::GridGeometry& geometry = *map.mutable_grid();
+    geometry.set_resolution(first.metadata.resolution);
+    geometry.mutable_origin()->set_x(first.metadata.origin_x);
+    geometry.mutable_origin()->set_y(first.metadata.origin_y);
+    geometry.mutable_size()->set_x(static_cast<uint32_t>(first.image.width));
+    geometry.mutable_size()->set_y(static_cast<uint32_t>(first.image.height));
+    geometry.mutable_size()->set_z(1);
+  } else {
+    FailCall(kCommand, "cannot read the map", existing.status(), args.map);
   }
-  v1::GridGeometry geometry;
-  geometry.set_resolution(snapshots[0].metadata.resolution);
-  geometry.mutable_origin()->set_x(snapshots[0].metadata.origin_x);
-  geometry.mutable_origin()->set_y(snapshots[0].metadata.origin_y);
-  geometry.mutable_size()->set_x(static_cast<uint32_t>(snapshots[0].image.width));
-  geometry.mutable_size()->set_y(static_cast<uint32_t>(snapshots[0].image.height));
-  geometry.mutable_size()->set_z(1);
-  const formats::GridPlacement grid = PlacementOf(GridMap(client, args, geometry));
-  std::vector<std::pair<uint32_t, uint32_t>> offsets(snapshots.size());
-  for (size_t i = 0; i < snapshots.size(); ++i) {
+  if (map.kind() != v1::MAP_KIND_GRID) {
+    FailInput(kCommand, absl::FailedPreconditionError(
+                            absl::StrCat("map ", args.map, " is a generic map; --map-server needs a grid map")));
+  }
+  const formats::GridPlacement grid = PlacementOf(map);
+  std::vector<std::pair<uint32_t, uint32_t>> offsets(files->size());
+  for (size_t i = 0; i < files->size(); ++i) {
     absl::Status placed =
-        formats::PlaceSnapshot(snapshots[i], grid, (*files)[i].yaml_path, offsets[i].first, offsets[i].second);
+        formats::PlaceSnapshot(read(i), grid, (*files)[i].yaml_path, offsets[i].first, offsets[i].second);
     if (!placed.ok()) FailInput(kCommand, placed);
   }
+  if (!existing.ok()) CreateMapIfMissing(client, map, kCommand);
+
   MapWriter writer(client, args.map, kCommand);
-  for (size_t i = 0; i < snapshots.size(); ++i) {
-    for (const formats::CellBatch& batch : formats::SnapshotBatches(snapshots[i], (*files)[i].time, offsets[i].first,
-                                                                    offsets[i].second, args.batch_cells)) {
+  for (size_t i = 0; i < files->size(); ++i) {
+    for (const formats::CellBatch& batch :
+         formats::SnapshotBatches(read(i), (*files)[i].time, offsets[i].first, offsets[i].second, args.batch_cells)) {
       writer.Send(batch);
     }
   }
   const IngestTotals totals = writer.Finish();
-  std::printf("ingested %zu map_server snapshots from %s into %s: %s\n", snapshots.size(), args.map_server_dir.c_str(),
+  std::printf("ingested %zu map_server snapshots from %s into %s: %s\n", files->size(), args.map_server_dir.c_str(),
               args.map.c_str(), MapWriter::Summary(totals, writer.first_rejections()).c_str());
 }
 
@@ -209,7 +227,7 @@ void RegisterIngestCommand(CLI::App& app) {
       "                  resolution, with the whole image inside the grid.\n"
       "--create makes a missing map: generic for --states; for --csv a grid just large enough for\n"
       "the file's cells at --resolution with origin (0, 0, 0); for --map-server the first snapshot's\n"
-      "grid. Every file is read and checked before anything is sent.\n"
+      "grid. Every file is read and checked before anything is sent (or a map created).\n"
       "Exit codes: 0 success, 1 bad input (the message names file:line and the field) or the daemon\n"
       "refused, 2 bad usage.\n"
       "\n"
