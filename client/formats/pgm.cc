@@ -80,8 +80,14 @@ absl::StatusOr<Image> ParsePgm(const std::string& bytes, const std::string& name
   if (!header.NextNumber(maxval) || maxval < 1 || maxval > 65535) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": bad PGM header: maxval must be in [1, 65535]"));
   }
+  // The data must be there before the image is allocated: a corrupt header cannot ask for 10 GB.
+  const size_t count = static_cast<size_t>(width) * height;
+  const size_t min_data_bytes = binary ? count : 2 * count - 1;  // P2: a digit and a blank per value
+  if (bytes.size() < min_data_bytes) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": truncated PGM data: a ", width, "x", height,
+                                                   " image needs at least ", min_data_bytes, " bytes of pixels"));
+  }
   Image image(static_cast<int>(width), static_cast<int>(height), 1);
-  const size_t count = image.pixels.size();
   if (binary) {
     if (!header.SkipOneWhitespace()) {
       return absl::InvalidArgumentError(absl::StrCat(name, ": bad PGM header: no whitespace after maxval"));

@@ -43,6 +43,8 @@ TEST(PgmTest, BinaryHeaderCommentBeforeData) {
 TEST(PgmTest, ErrorsNameTheFileAndTheProblem) {
   EXPECT_THAT(ParsePgm("P6\n1 1\n255\nabc", "c.ppm").status().message(), HasSubstr("c.ppm: not a PGM file"));
   EXPECT_THAT(ParsePgm("P5\n4 4\n255\nab", "t.pgm").status().message(), HasSubstr("t.pgm: truncated PGM data"));
+  // A header claiming a huge image is refused before anything is allocated.
+  EXPECT_THAT(ParsePgm("P5\n100000 100000\n255\nab", "h.pgm").status().message(), HasSubstr("truncated PGM data"));
   EXPECT_THAT(ParsePgm("P5\n0 4\n255\n", "w.pgm").status().message(), HasSubstr("width"));
   EXPECT_THAT(ParsePgm("P2\n2 1\n255\n7\n", "p2.pgm").status().message(), HasSubstr("expected 2 pixel values, read 1"));
   EXPECT_THAT(ParsePgm("P2\n1 1\n10\n11\n", "m.pgm").status().message(), HasSubstr("above maxval 10"));

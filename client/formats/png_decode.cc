@@ -72,6 +72,10 @@ absl::StatusOr<Image> DecodePng(const std::string& bytes) {
   }
   if (channels == 0) return absl::InvalidArgumentError("PNG: no IHDR chunk");
   if (!seen_end) return absl::InvalidArgumentError("PNG: no IEND chunk");
+  // Deflate compresses at most ~1032:1, so a small file cannot honestly claim a huge image.
+  if (static_cast<uint64_t>(width) * height * channels > 1032 * static_cast<uint64_t>(idat.size()) + 1024) {
+    return absl::InvalidArgumentError("PNG: IDAT is too small for the image's size");
+  }
 
   const size_t row_bytes = static_cast<size_t>(width) * channels;
   uLongf raw_size = (row_bytes + 1) * height;
