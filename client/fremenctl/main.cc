@@ -4,10 +4,14 @@
 #include "CLI/CLI.hpp"
 #include "client/fremenctl/admin_commands.h"
 #include "client/fremenctl/connection.h"
+#include "client/fremenctl/demo_command.h"
 #include "client/fremenctl/eval_command.h"
 #include "client/fremenctl/exit_codes.h"
+#include "client/fremenctl/ingest_command.h"
 #include "client/fremenctl/maps_command.h"
+#include "client/fremenctl/model_command.h"
 #include "client/fremenctl/query_commands.h"
+#include "client/fremenctl/region_command.h"
 #include "client/fremenctl/update_command.h"
 
 int main(int argc, char** argv) {
@@ -26,6 +30,10 @@ int main(int argc, char** argv) {
   fremen::client::RegisterBackupCommand(app);
   fremen::client::RegisterRestoreCommand(app);
   fremen::client::RegisterStatusCommand(app);
+  fremen::client::RegisterIngestCommand(app);
+  fremen::client::RegisterRegionCommand(app);
+  fremen::client::RegisterModelCommand(app);
+  fremen::client::RegisterDemoCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
