@@ -1,11 +1,11 @@
 // PredictRegion: a box of a grid at one time, streamed to the client in chunks
 // (server/region_plan.h), as a server-streaming reactor.
 //
-// The box is computed a block at a time (up to 1M cells: one MapStore::PredictBox call, which
+// The box is computed a block at a time (up to 256k cells: one MapStore::PredictBox call, which
 // spreads it over the map's shards), off the gRPC threads — on the blocking pool, or inline when
 // the block is small — and each block is cut into chunks of at most 1 MiB, the messages. The next
 // block is computed while the previous one's chunks are on the wire, and waits while a whole
-// block's chunks do, so memory stays bounded (about 13 MiB of floats) whatever the size of the box.
+// block's chunks do, so memory stays bounded (a few MiB) whatever the size of the box.
 // Between chunks the stream checks for cancellation and its deadline and stops there (a huge box
 // does not run on after the client has given up), and when the daemon drains for shutdown
 // (UNAVAILABLE, which clients retry). Like ServeUnary, the call is counted in the CallTracker,
