@@ -9,6 +9,7 @@ packages=(
   liblmdb-dev lmdb-utils zlib1g-dev libeigen3-dev libspdlog-dev libfftw3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-grpcio python3-protobuf python3-numpy
+  openssl  # the tests make their TLS certificates with it
 )
 
 missing=()
