@@ -357,6 +357,24 @@ TEST_F(FremenctlTest, StatusDescribesTheDaemon) {
   EXPECT_THAT(json.out, HasSubstr("\"map_count\":\"1\""));
 }
 
+TEST_F(FremenctlTest, BenchRunsTheIngestLoadGeneratorAgainstTheDaemon) {
+  // A small run: one stream of 100-cell scans into a 10³ grid, one window of half a second.
+  Result r = Run("bench ingest -- --map bench --grid 10 --streams 1 --cells 100 --warmup 0.2 --seconds 0.5 "
+                 "--repetitions 1 --predict-calls 0");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("cell-obs/s"));
+  // The generator talked to this daemon: its map is there, with what it ingested.
+  auto stats = client_->GetMapStats("bench");
+  ASSERT_TRUE(stats.ok()) << stats.status();
+  EXPECT_GT(stats->observations(), 0u);
+
+  Result bad = Run("bench nosuch");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(bad.err, HasSubstr("nosuch not in {ingest,query}"));
+  // The generator's own usage errors are its exit code.
+  EXPECT_NE(Run("bench ingest -- --streams 0").exit_code, 0);
+}
+
 TEST_F(FremenctlTest, UnreachableDaemonSaysToStartItOrFixTheAddress) {
   const std::string nowhere = FreeLoopbackAddress();
   // The option after the subcommand wins over FREMEN_ADDRESS.

@@ -3,6 +3,7 @@
 // (e.g. bad input file), 2 bad usage.
 #include "CLI/CLI.hpp"
 #include "client/fremenctl/admin_commands.h"
+#include "client/fremenctl/bench_command.h"
 #include "client/fremenctl/connection.h"
 #include "client/fremenctl/demo_command.h"
 #include "client/fremenctl/eval_command.h"
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
   fremen::client::RegisterRegionCommand(app);
   fremen::client::RegisterModelCommand(app);
   fremen::client::RegisterDemoCommand(app);
+  fremen::client::RegisterBenchCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
