@@ -260,6 +260,7 @@ absl::Status MapStore::Close() {
   queue_ready_.notify_one();
   if (committer_.joinable()) committer_.join();
   if (applier_.joinable()) applier_.join();
+  WaitCheckpointWrite();  // the applier waits for it before it ends; the applier is gone now
   std::lock_guard lock(queue_mutex_);
   return write_error_;
 }
@@ -377,13 +378,20 @@ void MapStore::ApplyLoop() {
     if (stage.final) FinishPublication();
     // A checkpoint waits for the publication in progress: taken halfway, it would record states
     // published after the publication's log record as if that record had not been applied.
-    if (!publication_.has_value() &&
-        (!waiting_checkpoints_.empty() || wal_->bytes() >= options_.checkpoint_log_bytes || stage.final)) {
-      const absl::Status status = DoCheckpoint(applied_lsn_);
-      for (Control& c : waiting_checkpoints_) c.done(status.ok() ? absl::StatusOr<uint64_t>(0) : status);
-      waiting_checkpoints_.clear();
+    if (!publication_.has_value()) {
+      // Asked for (a caller waits, or the map closes): now. Due by the log's size: unless the
+      // previous checkpoint is still being written — the log is dropped once it is.
+      const bool asked = !waiting_checkpoints_.empty() || stage.final;
+      const bool due = wal_->bytes() >= options_.checkpoint_log_bytes && !CheckpointWriting();
+      if (asked || due) {
+        StartCheckpoint(applied_lsn_, std::move(waiting_checkpoints_));
+        waiting_checkpoints_.clear();
+      }
     }
-    if (stage.final) return;
+    if (stage.final) {
+      WaitCheckpointWrite();
+      return;
+    }
   }
 }
 
@@ -456,16 +464,37 @@ void MapStore::FinishPublication() {
   while (publication_.has_value()) ContinuePublication();
 }
 
-absl::Status MapStore::DoCheckpoint(uint64_t lsn) {
+void MapStore::StartCheckpoint(uint64_t lsn, std::vector<Control> waiting) {
+  WaitCheckpointWrite();
+  auto images = std::make_shared<std::vector<Shard::CheckpointImage>>(shards_.size());
+  workers_->RunOnAll([&](uint32_t s) { (*images)[s] = shards_[s]->PrepareCheckpoint(lsn, applied_dedup_); });
+  checkpoint_write_ = std::async(std::launch::async, [this, lsn, images, waiting = std::move(waiting)]() mutable {
+    const absl::Status status = WriteCheckpoint(lsn, *images);
+    images.reset();  // the encoded states can be large: free them before answering
+    for (Control& c : waiting) c.done(status.ok() ? absl::StatusOr<uint64_t>(0) : status);
+  });
+}
+
+bool MapStore::CheckpointWriting() const {
+  return checkpoint_write_.valid() &&
+         checkpoint_write_.wait_for(std::chrono::seconds(0)) != std::future_status::ready;
+}
+
+void MapStore::WaitCheckpointWrite() {
+  if (checkpoint_write_.valid()) checkpoint_write_.get();
+}
+
+absl::Status MapStore::WriteCheckpoint(uint64_t lsn, std::vector<Shard::CheckpointImage>& images) {
+  // No backup copies the shards while they change, so that every copy is at one log position.
   std::lock_guard backup(backup_mutex_);
-  std::vector<absl::Status> results(shards_.size());
-  workers_->RunOnAll([&](uint32_t s) { results[s] = shards_[s]->Checkpoint(lsn, applied_dedup_); });
+  std::vector<std::future<absl::Status>> writes;
+  for (uint32_t s = 0; s < shards_.size(); ++s) {
+    writes.push_back(std::async(std::launch::async, [this, s, &images] { return shards_[s]->WriteCheckpoint(images[s]); }));
+  }
   absl::Status status;
-  for (const absl::Status& r : results) {
-    if (!r.ok()) {
-      status = r;
-      break;
-    }
+  for (auto& w : writes) {
+    const absl::Status r = w.get();
+    if (status.ok()) status = r;
   }
   if (status.ok()) {
     std::lock_guard wal(wal_mutex_);

@@ -17,6 +17,7 @@
 #include <condition_variable>
 #include <deque>
 #include <functional>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -164,7 +165,14 @@ class MapStore {
   void Latch(const absl::Status& status);
   void ApplyLoop();
   void ApplyGroup(std::vector<Pending>& group);
-  absl::Status DoCheckpoint(uint64_t lsn);
+  // Checkpoints at `lsn` in two steps (Shard::PrepareCheckpoint): the applier encodes every
+  // shard's changed states — the only stall of ingest, a fraction of the write — and a background
+  // thread writes them into LMDB, drops the covered log and then answers `waiting`. One image at a
+  // time: a new checkpoint first waits for the previous write.
+  void StartCheckpoint(uint64_t lsn, std::vector<Control> waiting);
+  absl::Status WriteCheckpoint(uint64_t lsn, std::vector<Shard::CheckpointImage>& images);
+  bool CheckpointWriting() const;
+  void WaitCheckpointWrite();
   // The applier's publication in progress (see PublishModels): Start marks the states (finishing
   // one still in progress first), Continue publishes a slice, Finish the rest.
   void StartPublication(Control control);
@@ -197,6 +205,7 @@ class MapStore {
   std::optional<Control> publication_;     // applier only: the publication in progress
   uint64_t publication_total_ = 0;         // applier only: its states
   std::vector<Control> waiting_checkpoints_;  // applier only: checkpoints asked during a publication
+  std::future<void> checkpoint_write_;        // applier only: the image being written, if any
 
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_ready_;

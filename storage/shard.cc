@@ -392,15 +392,63 @@ void Shard::ForEachLabel(
   for (const auto& [key, label] : labels_) f(key, label.first, label.second);
 }
 
-absl::Status Shard::Checkpoint(uint64_t lsn, const DedupTable& dedup) {
-  std::shared_lock lock(mutex_);  // the writer is the caller: only readers run alongside
-  std::vector<uint32_t> dirty = dirty_slots_;
-  std::sort(dirty.begin(), dirty.end(), [&](uint32_t a, uint32_t b) { return slots_[a].key < slots_[b].key; });
-  std::vector<uint64_t> dirty_bricks;
-  for (uint32_t slot : dirty) {
-    const uint64_t brick = BrickOf(slots_[slot].key);
-    if (dirty_bricks.empty() || dirty_bricks.back() != brick) dirty_bricks.push_back(brick);
+Shard::CheckpointImage Shard::PrepareCheckpoint(uint64_t lsn, const DedupTable& dedup) {
+  CheckpointImage image;
+  image.lsn = lsn;
+  {
+    std::shared_lock lock(mutex_);  // the writer is the caller: only readers run alongside
+    std::vector<uint32_t> dirty = dirty_slots_;
+    std::sort(dirty.begin(), dirty.end(), [&](uint32_t a, uint32_t b) { return slots_[a].key < slots_[b].key; });
+    std::vector<uint64_t> dirty_bricks;
+    for (uint32_t slot : dirty) {
+      const uint64_t brick = BrickOf(slots_[slot].key);
+      if (dirty_bricks.empty() || dirty_bricks.back() != brick) dirty_bricks.push_back(brick);
+    }
+    for (uint32_t slot : dirty) {
+      const uint32_t d = slots_[slot].dynamic;
+      if (d == kNone) continue;
+      const uint64_t key = slots_[slot].key;
+      image.dynamic.emplace_back(key, model::EncodeStateModel(ModelOf(d)));
+      if (lossless_) image.lossless.emplace_back(key, lossless_histories_[d].Encode());
+      if (wide_.wide(d)) image.wide.emplace_back(key, wide_.Encode(d));
+    }
+    // A brick's never-changed states are written together; a brick left with none is deleted
+    // (an empty value).
+    for (uint64_t brick : dirty_bricks) {
+      const Brick& data = brick_data_[bricks_.at(brick)];
+      StaticBrick value;
+      for (uint32_t i = 0; i < 512; ++i) {
+        const uint32_t slot = SlotAt(data, i);
+        if (slot != kNone && slots_[slot].dynamic == kNone) value.Add(i, slots_[slot].static_state);
+      }
+      image.statics.emplace_back(brick, value.empty() ? std::string() : value.Encode());
+    }
+    for (uint64_t key : dirty_labels_) {
+      const auto& [name, group] = labels_.at(key);
+      std::string value;
+      model::PutVarint64(&value, name.size());
+      value += name;
+      model::PutVarint64(&value, group.size());
+      value += group;
+      image.labels.emplace_back(key, std::move(value));
+    }
+    image.touched = EncodeTouched();
+    image.dedup = dedup.Encode();
   }
+  std::unique_lock exclusive(mutex_);
+  for (uint32_t slot : dirty_slots_) slots_[slot].dirty = 0;
+  dirty_slots_.clear();
+  dirty_labels_.clear();
+  checkpoint_lsn_ = lsn;
+  checkpoint_dedup_ = dedup;
+  return image;
+}
+
+absl::Status Shard::WriteCheckpoint(const CheckpointImage& image) {
+  std::lock_guard lock(checkpoint_write_mutex_);
+  // The states of a failed image are clean in memory but not on disk: a later image must not
+  // move the checkpoint past them.
+  if (!checkpoint_write_error_.ok()) return checkpoint_write_error_;
   const absl::Status written = env_->Write([&](LmdbTxn& txn) -> absl::Status {
     auto static_db = txn.Db(kStaticDb);
     auto dynamic_db = txn.Db(kDynamicDb);
@@ -411,56 +459,29 @@ absl::Status Shard::Checkpoint(uint64_t lsn, const DedupTable& dedup) {
     for (auto* db : {&static_db, &dynamic_db, &lossless_db, &wide_db, &labels_db, &meta_db}) {
       if (!db->ok()) return db->status();
     }
-    for (uint32_t slot : dirty) {
-      const uint32_t d = slots_[slot].dynamic;
-      if (d == kNone) continue;
-      const auto key = KeyBytes(slots_[slot].key);
-      const std::string record = model::EncodeStateModel(ModelOf(d));
-      if (absl::Status s = txn.Put(*dynamic_db, key, Bytes(record)); !s.ok()) return s;
-      if (lossless_) {
-        const std::string history = lossless_histories_[d].Encode();
-        if (absl::Status s = txn.Put(*lossless_db, key, Bytes(history)); !s.ok()) return s;
+    const auto put_all = [&](MDB_dbi db, const std::vector<std::pair<uint64_t, std::string>>& records) {
+      for (const auto& [key, value] : records) {
+        if (absl::Status s = txn.Put(db, KeyBytes(key), Bytes(value)); !s.ok()) return s;
       }
-      if (wide_.wide(d)) {
-        if (absl::Status s = txn.Put(*wide_db, key, Bytes(wide_.Encode(d))); !s.ok()) return s;
-      }
-    }
-    // A brick's never-changed states are written together; a brick left with none is deleted.
-    for (uint64_t brick : dirty_bricks) {
-      const Brick& data = brick_data_[bricks_.at(brick)];
-      StaticBrick value;
-      for (uint32_t i = 0; i < 512; ++i) {
-        const uint32_t slot = SlotAt(data, i);
-        if (slot != kNone && slots_[slot].dynamic == kNone) value.Add(i, slots_[slot].static_state);
-      }
+      return absl::OkStatus();
+    };
+    if (absl::Status s = put_all(*dynamic_db, image.dynamic); !s.ok()) return s;
+    if (absl::Status s = put_all(*lossless_db, image.lossless); !s.ok()) return s;
+    if (absl::Status s = put_all(*wide_db, image.wide); !s.ok()) return s;
+    for (const auto& [brick, value] : image.statics) {
       const auto key = KeyBytes(brick);
-      absl::Status s = value.empty() ? txn.Delete(*static_db, key) : txn.Put(*static_db, key, Bytes(value.Encode()));
+      absl::Status s = value.empty() ? txn.Delete(*static_db, key) : txn.Put(*static_db, key, Bytes(value));
       if (!s.ok()) return s;
     }
-    for (uint64_t key : dirty_labels_) {
-      const auto& [name, group] = labels_.at(key);
-      std::string value;
-      model::PutVarint64(&value, name.size());
-      value += name;
-      model::PutVarint64(&value, group.size());
-      value += group;
-      if (absl::Status s = txn.Put(*labels_db, KeyBytes(key), Bytes(value)); !s.ok()) return s;
-    }
+    if (absl::Status s = put_all(*labels_db, image.labels); !s.ok()) return s;
     uint8_t lsn_bytes[8];
-    std::memcpy(lsn_bytes, &lsn, 8);
+    std::memcpy(lsn_bytes, &image.lsn, 8);
     if (absl::Status s = txn.Put(*meta_db, Bytes(kLsnKey), lsn_bytes); !s.ok()) return s;
-    if (absl::Status s = txn.Put(*meta_db, Bytes(kTouchedKey), Bytes(EncodeTouched())); !s.ok()) return s;
-    return txn.Put(*meta_db, Bytes(kDedupKey), Bytes(dedup.Encode()));
+    if (absl::Status s = txn.Put(*meta_db, Bytes(kTouchedKey), Bytes(image.touched)); !s.ok()) return s;
+    return txn.Put(*meta_db, Bytes(kDedupKey), Bytes(image.dedup));
   });
-  if (!written.ok()) return written;
-  lock.unlock();
-  std::unique_lock exclusive(mutex_);
-  for (uint32_t slot : dirty_slots_) slots_[slot].dirty = 0;
-  dirty_slots_.clear();
-  dirty_labels_.clear();
-  checkpoint_lsn_ = lsn;
-  checkpoint_dedup_ = dedup;
-  return absl::OkStatus();
+  if (!written.ok()) checkpoint_write_error_ = written;
+  return written;
 }
 
 absl::Status Shard::Load() {

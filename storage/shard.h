@@ -28,10 +28,12 @@
 #include <functional>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <shared_mutex>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/container/flat_hash_map.h"
@@ -137,7 +139,21 @@ class Shard {
   size_t PublishAll(const std::function<void(uint64_t)>& progress = nullptr);
   // Writes every state changed since the last checkpoint, the dedup table and `lsn` in one durable
   // transaction.
-  absl::Status Checkpoint(uint64_t lsn, const DedupTable& dedup);
+  absl::Status Checkpoint(uint64_t lsn, const DedupTable& dedup) { return WriteCheckpoint(PrepareCheckpoint(lsn, dedup)); }
+  // The same in two steps, so that the writer stalls only for the first: PrepareCheckpoint encodes
+  // every state changed since the last one (with the dedup table, the touched flags and `lsn`) into
+  // an image and marks them clean — the writer calls it; WriteCheckpoint puts an image into LMDB in
+  // one durable transaction on any thread, while the writer goes on applying batches. Images must
+  // be written in the order they were prepared, one at a time. Once a write fails, every later
+  // write fails with its error: the failed image's states are clean in memory but not on disk.
+  struct CheckpointImage {
+    uint64_t lsn = 0;
+    std::vector<std::pair<uint64_t, std::string>> dynamic, lossless, wide, labels;  // state key → record
+    std::vector<std::pair<uint64_t, std::string>> statics;  // brick → StaticBrick, empty = delete it
+    std::string touched, dedup;
+  };
+  CheckpointImage PrepareCheckpoint(uint64_t lsn, const DedupTable& dedup);
+  absl::Status WriteCheckpoint(const CheckpointImage& image);
   uint64_t checkpoint_lsn() const { return checkpoint_lsn_; }
   const DedupTable& checkpoint_dedup() const { return checkpoint_dedup_; }
 
@@ -256,7 +272,9 @@ class Shard {
   std::vector<uint32_t> scan_wide_cells_;
   std::vector<float> scan_wide_values_;
 
-  uint64_t checkpoint_lsn_ = 0;
+  uint64_t checkpoint_lsn_ = 0;  // of the last image prepared
+  std::mutex checkpoint_write_mutex_;
+  absl::Status checkpoint_write_error_;  // guarded by checkpoint_write_mutex_
   DedupTable checkpoint_dedup_;
 };
 
