@@ -14,6 +14,7 @@
 #include "server/map_list.h"
 #include "server/map_name.h"
 #include "server/operation_convert.h"
+#include "server/query_convert.h"
 #include "storage/catalog.h"
 
 namespace fremen::server {
@@ -269,6 +270,11 @@ absl::Status AdminServiceImpl::FillStatus(v1::GetServerStatusResponse& response)
       failed.set_error(fault.ToString());
     }
     const storage::MapStats stats = (*map)->Stats();
+    if (stats.last_update) {
+      v1::MapLastUpdate& last = *response.add_map_updates();
+      last.set_map(info.name);
+      UpdateRecordToProto(*stats.last_update, *last.mutable_update());
+    }
     response.set_state_count(response.state_count() + stats.totals.states);
     response.set_dynamic_state_count(response.dynamic_state_count() + stats.totals.dynamic_states);
   }

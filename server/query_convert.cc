@@ -145,18 +145,18 @@ void MapStatsToProto(const storage::MapStats& stats, v1::MapStats& out) {
   out.set_log_bytes(stats.log_bytes);
   out.set_lossless_estimation_error(stats.estimation_error);
   out.set_lossless_prediction_error(stats.lossless_prediction_error);
-  if (stats.last_update) {
-    const storage::UpdateRecord& u = *stats.last_update;
-    v1::MapUpdate& m = *out.mutable_last_update();
-    const double whole = std::floor(u.start_time);
-    m.mutable_start_time()->set_seconds(static_cast<int64_t>(whole));
-    m.mutable_start_time()->set_nanos(static_cast<int32_t>((u.start_time - whole) * 1e9));
-    m.set_duration_seconds(u.duration_seconds);
-    m.set_states_updated(u.states_updated);
-    m.set_prediction_error_before(u.prediction_error_before);
-    m.set_prediction_error_after(u.prediction_error_after);
-    m.mutable_order_histogram()->Add(u.order_histogram.begin(), u.order_histogram.end());
-  }
+  if (stats.last_update) UpdateRecordToProto(*stats.last_update, *out.mutable_last_update());
+}
+
+void UpdateRecordToProto(const storage::UpdateRecord& u, v1::MapUpdate& m) {
+  const double whole = std::floor(u.start_time);
+  m.mutable_start_time()->set_seconds(static_cast<int64_t>(whole));
+  m.mutable_start_time()->set_nanos(static_cast<int32_t>((u.start_time - whole) * 1e9));
+  m.set_duration_seconds(u.duration_seconds);
+  m.set_states_updated(u.states_updated);
+  m.set_prediction_error_before(u.prediction_error_before);
+  m.set_prediction_error_after(u.prediction_error_after);
+  m.mutable_order_histogram()->Add(u.order_histogram.begin(), u.order_histogram.end());
 }
 
 }  // namespace fremen::server

@@ -22,5 +22,7 @@ void StateModelToProto(const storage::MapInfo& map, const model::ModelSettings& 
                        const storage::StateSnapshot& snapshot, bool include_spectrum, v1::StateModel& out);
 
 void MapStatsToProto(const storage::MapStats& stats, v1::MapStats& out);
+// A map's last update job (storage/update_record.h), as GetMapStats and GetServerStatus show it.
+void UpdateRecordToProto(const storage::UpdateRecord& record, v1::MapUpdate& out);
 
 }  // namespace fremen::server

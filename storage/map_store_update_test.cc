@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <filesystem>
+#include <chrono>
 #include <thread>
 
 #include "storage/map_store.h"
@@ -149,14 +150,15 @@ TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsIts
   }
   const std::vector<float> before = store->Predict(watched, {&t, 1}, {});
 
-  std::atomic<bool> publishing = true;
-  std::atomic<uint64_t> acked_during = 0, torn = 0, reads = 0;
+  std::atomic<bool> publishing = true, started = false;
+  std::atomic<uint64_t> acked = 0, acked_during = 0, torn = 0, reads = 0;
   std::thread writer([&] {
     // Rows y < 128 keep being observed; they include states the publication has not reached yet.
     for (uint64_t i = 3; publishing; ++i) {
       auto ack = store->Write(Planes(map, 2, i, 0, kNz, kT0 + 3600.0 * i, 128));
       ASSERT_TRUE(ack.ok()) << ack.status();
-      if (publishing) ++acked_during;
+      ++acked;
+      if (started && publishing) ++acked_during;
     }
   });
   std::vector<std::vector<float>> seen;
@@ -166,6 +168,10 @@ TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsIts
       ++reads;
     }
   });
+  // Both are under way before the publication starts (a loaded machine may be slow to start a
+  // thread or to sync the log's first batch), so that the figures below measure the publication.
+  while (acked == 0 || reads == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  started = true;
   auto published = store->PublishModels();
   publishing = false;
   writer.join();

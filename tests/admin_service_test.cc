@@ -633,6 +633,14 @@ TEST_F(AdminServiceTest, UpdatesOnlyObservedStatesAndMapStatsKeepTheLastJob) {
   EXPECT_EQ(restarted.last_update().states_updated(), 2u);
   EXPECT_DOUBLE_EQ(restarted.last_update().prediction_error_after(), third.update().prediction_error_after());
   EXPECT_THAT(restarted.last_update().order_histogram(), ElementsAreArray(third.update().order_histogram()));
+  // Server status shows the same record, though the operation itself did not survive the restart.
+  v1::GetServerStatusResponse status;
+  ASSERT_TRUE(Status(&status).ok());
+  EXPECT_EQ(status.last_updates_size(), 0);
+  ASSERT_EQ(status.map_updates_size(), 1);
+  EXPECT_EQ(status.map_updates(0).map(), "lab");
+  EXPECT_EQ(status.map_updates(0).update().states_updated(), 2u);
+  EXPECT_THAT(status.map_updates(0).update().order_histogram(), ElementsAreArray(third.update().order_histogram()));
 }
 
 // A lossless map's update reconstructs each history, re-transforms it, selects orders on it and
