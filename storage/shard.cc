@@ -206,10 +206,14 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
   for (size_t j = 0; j < scan_cells_.size(); ++j) {
     const uint32_t d = scan_cells_[j];
     if (spectra_.header(d).n >= widen_at_) wide_.Widen(d, spectra_.body(d));
-    persistence_[d].Observe(t, scan_values_[j]);
-    // The batch was validated against the map's lossless origin, so Add cannot fail on time.
-    if (lossless_) (void)lossless_histories_[d].Add(t, scan_values_[j]);
+    ObserveBesidesSpectrum(d, t, scan_values_[j]);
   }
+}
+
+void Shard::ObserveBesidesSpectrum(uint32_t d, double t, float value) {
+  persistence_[d].Observe(t, value);
+  // The batch was validated against the map's lossless origin, so Add cannot fail on time.
+  if (lossless_) (void)lossless_histories_[d].Add(t, value);
 }
 
 void Shard::ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring) {
@@ -221,8 +225,7 @@ void Shard::ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring
   for (size_t j = 0; j < scan_wide_cells_.size(); ++j) {
     const uint32_t d = scan_wide_cells_[j];
     wide_.Fold(d, spectra_.header(d), spectra_.body(d), phasors, scan_wide_values_[j]);
-    persistence_[d].Observe(t, scan_wide_values_[j]);
-    if (lossless_) (void)lossless_histories_[d].Add(t, scan_wide_values_[j]);
+    ObserveBesidesSpectrum(d, t, scan_wide_values_[j]);
   }
   scan_wide_cells_.clear();
   scan_wide_values_.clear();

@@ -18,8 +18,9 @@
 //             "touched" → the dynamic states observed since their last publication (delta varints)
 // Keys are big-endian so that LMDB's order is key order (Morton order for grids).
 //
-// Thread-safety: Apply*, Checkpoint and Publish are called by one writer (the map's committer,
-// through the shard's owner); readers may call the const query methods concurrently with them —
+// Thread-safety: Apply*, PrepareCheckpoint and Publish* are called by one writer (the map's committer,
+// through the shard's owner; WriteCheckpoint may run on another thread); readers may call the
+// const query methods concurrently with them —
 // an internal shared mutex keeps a reader from seeing a half-applied batch.
 #pragma once
 
@@ -137,10 +138,8 @@ class Shard {
   // A whole publication at once (recovery's replay, tests); returns the states published.
   // `progress(states done)` is called after every block of states.
   size_t PublishAll(const std::function<void(uint64_t)>& progress = nullptr);
-  // Writes every state changed since the last checkpoint, the dedup table and `lsn` in one durable
-  // transaction.
-  absl::Status Checkpoint(uint64_t lsn, const DedupTable& dedup) { return WriteCheckpoint(PrepareCheckpoint(lsn, dedup)); }
-  // The same in two steps, so that the writer stalls only for the first: PrepareCheckpoint encodes
+  // A checkpoint writes every state changed since the last one, the dedup table and `lsn` in one
+  // durable transaction, in two steps so that the writer stalls only for the first: PrepareCheckpoint encodes
   // every state changed since the last one (with the dedup table, the touched flags and `lsn`) into
   // an image and marks them clean — the writer calls it; WriteCheckpoint puts an image into LMDB in
   // one durable transaction on any thread, while the writer goes on applying batches. Images must
@@ -205,6 +204,8 @@ class Shard {
   uint32_t Promote(uint32_t slot);  // static → dynamic; returns the dynamic index
   // Apply's second part: scores and folds the scan's observations of wide states (scan_wide_*).
   void ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring);
+  // What every observation of a dynamic state updates besides its spectrum and order errors.
+  void ObserveBesidesSpectrum(uint32_t d, double t, float value);
   uint32_t AddDynamic(uint32_t slot);
   void MarkDirty(uint32_t slot);
   float PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f, const float* sin_f,

@@ -85,7 +85,8 @@ double Ingest(MapStore& store, uint64_t first, uint64_t scans, bool coherent, in
   std::vector<ObservationBatch> prepared;
   for (uint64_t i = first; i < first + scans; ++i) {
     prepared.push_back(MakeScan(i, coherent, rng));
-    prepared.back().writer_id = prepared.back().writer_id * 100 + i % writers;
+    // The thread that submits it (every writers-th scan) is its writer.
+    prepared.back().writer_id = prepared.back().writer_id * 100 + (i - first) % writers;
   }
   std::mutex m;
   std::condition_variable cv;

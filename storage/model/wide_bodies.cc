@@ -7,19 +7,20 @@
 
 namespace fremen::model {
 
-void WideBodies::Widen(uint32_t record, const float* body) {
+double* WideBodies::RowFor(uint32_t record) {
   if (record >= row_of_.size()) row_of_.resize(record + 1, kNone);
   if (row_of_[record] == kNone) {
-    row_of_[record] = static_cast<uint32_t>(size());
-    bodies_.resize(bodies_.size() + reals_);
+    row_of_[record] = static_cast<uint32_t>(rows_++);
+    bodies_.resize(rows_ * reals_);
   }
-  double* wide = bodies_.data() + size_t{row_of_[record]} * reals_;
-  for (size_t i = 0; i < reals_; ++i) wide[i] = body[i];
+  return Row(record);
 }
+
+void WideBodies::Widen(uint32_t record, const float* body) { std::copy(body, body + reals_, RowFor(record)); }
 
 void WideBodies::Fold(uint32_t record, SpectrumHeader& header, float* body, const ScanPhasors<double>& phasors,
                       float s) {
-  double* wide = bodies_.data() + size_t{row_of_[record]} * reals_;
+  double* wide = Row(record);
   FoldObservation(header, wide, phasors, s);
   for (size_t i = 0; i < reals_; ++i) body[i] = static_cast<float>(wide[i]);
 }
@@ -29,7 +30,7 @@ constexpr uint8_t kWideVersion = 1;
 }  // namespace
 
 std::string WideBodies::Encode(uint32_t record) const {
-  const double* wide = bodies_.data() + size_t{row_of_[record]} * reals_;
+  const double* wide = Row(record);
   std::string out;
   out.reserve(1 + reals_ * sizeof(double));
   out.push_back(static_cast<char>(kWideVersion));
@@ -48,9 +49,7 @@ absl::Status WideBodies::Decode(uint32_t record, std::string_view bytes) {
   std::vector<double> body(reals_);
   for (double& v : body) v = r.Double("body");
   if (absl::Status s = r.Finish(); !s.ok()) return s;
-  std::vector<float> unused(reals_);
-  Widen(record, unused.data());
-  std::copy(body.begin(), body.end(), bodies_.begin() + size_t{row_of_[record]} * reals_);
+  std::copy(body.begin(), body.end(), RowFor(record));
   return absl::OkStatus();
 }
 

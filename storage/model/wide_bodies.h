@@ -31,7 +31,7 @@ class WideBodies {
 
   bool wide(uint32_t record) const { return record < row_of_.size() && row_of_[record] != kNone; }
   // Records held wide.
-  size_t size() const { return bodies_.size() / (reals_ == 0 ? 1 : reals_); }
+  size_t size() const { return rows_; }
   size_t bytes() const { return bodies_.capacity() * sizeof(double) + row_of_.capacity() * sizeof(uint32_t); }
 
   // Makes `record` wide, its double body starting as `body` (4K floats); a wide record's double
@@ -49,7 +49,13 @@ class WideBodies {
 
  private:
   static constexpr uint32_t kNone = UINT32_MAX;
+  // The double body of `record`, a new (zero) row when it is not wide yet.
+  double* RowFor(uint32_t record);
+  double* Row(uint32_t record) { return bodies_.data() + size_t{row_of_[record]} * reals_; }
+  const double* Row(uint32_t record) const { return bodies_.data() + size_t{row_of_[record]} * reals_; }
+
   size_t reals_;
+  size_t rows_ = 0;
   std::vector<uint32_t> row_of_;  // record → row of bodies_, kNone when not wide
   std::vector<double> bodies_;    // reals_ per row
 };
