@@ -28,8 +28,12 @@ run: build
 demo-eval: build
 	@bash scripts/run-demo-eval.sh $(BUILD)/bin
 
+# Every test, then how many each suite ran (tests/test_suites.py; the suites ctest must hold are
+# listed in tests/expected_suites.txt and checked by the test meta.suites_registered).
 test: build
-	@cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+	@cd $(BUILD) && status=0; ctest --output-on-failure -j$(JOBS) --output-junit ctest-junit.xml || status=$$?; \
+	  /usr/bin/python3 $(CURDIR)/tests/test_suites.py summary ctest-junit.xml $(CURDIR)/tests/expected_suites.txt; \
+	  exit $$status
 
 bench: build
 	@$(BUILD)/bin/fremen_model_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
