@@ -13,8 +13,9 @@ namespace fremen::storage {
 namespace {
 
 // Incremental states are published this many at a time under the exclusive lock: about 10-30 µs
-// of readers' wait per chunk at ~2M states/s, and the budget is checked between chunks.
-constexpr size_t kChunk = 1024;
+// of readers' wait per chunk at ~2M states/s, and the budget is checked between chunks. (Not named
+// kChunk: inside Shard's methods that name is Shard::kChunk, the slot runs of 64 keys.)
+constexpr size_t kStatesPerLock = 1024;
 
 }  // namespace
 
@@ -58,7 +59,7 @@ bool Shard::ContinuePublication(std::chrono::nanoseconds budget) {
         PublishState(d, /*history_updated=*/true);
       }
     } else {
-      const size_t end = std::min(publication_list_.size(), publication_cursor_ + kChunk);
+      const size_t end = std::min(publication_list_.size(), publication_cursor_ + kStatesPerLock);
       std::unique_lock lock(mutex_);
       for (; publication_cursor_ < end; ++publication_cursor_) {
         const uint32_t d = publication_list_[publication_cursor_];
