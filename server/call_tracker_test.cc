@@ -11,8 +11,10 @@ namespace {
 TEST(CallTrackerTest, DrainWaitsForCallsInFlight) {
   CallTracker calls;
   ASSERT_TRUE(calls.Begin().ok());
+  // The call ends only once draining has begun (Begin is refused from then on), so a Drain that
+  // did not wait would find it in flight and return 1.
   std::thread finisher([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    while (calls.Begin().ok()) calls.End();
     calls.End();
   });
   EXPECT_EQ(calls.Drain(absl::Seconds(30)), 0);

@@ -152,11 +152,17 @@ TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsIts
 
   std::atomic<bool> publishing = true, started = false;
   std::atomic<uint64_t> acked = 0, acked_during = 0, torn = 0, reads = 0;
+  absl::Status write_failure;  // the writer's error, read once it has been joined
+  std::atomic<bool> write_failed = false;
   std::thread writer([&] {
     // Rows y < 128 keep being observed; they include states the publication has not reached yet.
     for (uint64_t i = 3; publishing; ++i) {
       auto ack = store->Write(Planes(map, 2, i, 0, kNz, kT0 + 3600.0 * i, 128));
-      ASSERT_TRUE(ack.ok()) << ack.status();
+      if (!ack.ok()) {
+        write_failure = ack.status();
+        write_failed = true;
+        break;
+      }
       ++acked;
       if (started && publishing) ++acked_during;
     }
@@ -170,12 +176,18 @@ TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsIts
   });
   // Both are under way before the publication starts (a loaded machine may be slow to start a
   // thread or to sync the log's first batch), so that the figures below measure the publication.
-  while (acked == 0 || reads == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(2);
+  while ((acked == 0 || reads == 0) && !write_failed && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const bool under_way = acked > 0 && reads > 0;
   started = true;
-  auto published = store->PublishModels();
+  auto published = under_way ? store->PublishModels() : absl::StatusOr<uint64_t>(absl::AbortedError("not run"));
   publishing = false;
   writer.join();
   reader.join();
+  ASSERT_TRUE(write_failure.ok()) << write_failure;
+  ASSERT_TRUE(under_way) << "the writer or the reader did not start within 2 minutes";
   ASSERT_TRUE(published.ok()) << published.status();
   EXPECT_EQ(*published, 256u * 256 * kNz);
   const std::vector<float> after = store->Predict(watched, {&t, 1}, {});

@@ -111,6 +111,7 @@ absl::Status Connection::CallIdempotent(const CallOptions& call, absl::string_vi
     if (!IsRetryable(status.code()) || !backoff.MayRetry()) return status;
     const absl::Duration delay = backoff.Next();
     if (absl::Now() + delay >= deadline) return status;
+    if (options_.retry.on_retry) options_.retry.on_retry(status, delay);
     absl::SleepFor(delay);
   }
 }

@@ -5,9 +5,11 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
+#include "absl/status/status.h"
 #include "absl/time/time.h"
 
 namespace fremen::client {
@@ -28,6 +30,9 @@ struct RetryPolicy {
   // Attempts of one call in all (the first included); 0 = as many as fit before the call's
   // deadline. Default: 0.
   int max_attempts = 0;
+  // Called before each retry of an idempotent call, with the failed attempt's status and the delay
+  // about to be slept (for logging or counting; it must not block). Default: none.
+  std::function<void(const absl::Status&, absl::Duration)> on_retry;
 };
 
 struct ConnectionOptions {
