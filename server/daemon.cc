@@ -185,6 +185,8 @@ absl::Status Daemon::OpenStore() {
   options.default_shards = config_.shards;
   options.checkpoint_log_bytes = config_.checkpoint_log_mb << 20;
   const auto store_log = Logger(kStoreLogger);
+  // What recovery repairs on its own (a torn log tail cut) is logged at warning.
+  options.log_warning = [store_log](const std::string& line) { store_log->warn("{}", line); };
   store_log->info("opening {} (recovering every map)", config_.data_dir);
   const absl::Time start = absl::Now();
   auto store = storage::Store::Open(config_.data_dir, options);

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <future>
 
 #include "absl/strings/str_cat.h"
@@ -71,7 +71,7 @@ absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const MapInfo& info, co
     return absl::Status(s.code(), absl::StrCat("map ", info.name, ": recovery: ", s.message()));
   }
   // Only a report: an unreadable record is shown as none rather than keeping the map closed.
-  if (auto last = ReadUpdateRecord(LastUpdatePath(dir)); last.ok()) store->last_update_ = *std::move(last);
+  if (auto last = ReadUpdateRecord(options.env, LastUpdatePath(dir)); last.ok()) store->last_update_ = *std::move(last);
   store->workers_ = std::make_unique<ShardWorkers>(info.shards, "fremen-shard");
   store->committer_ = std::thread([s = store.get()] { s->CommitLoop(); });
   store->applier_ = std::thread([s = store.get()] { s->ApplyLoop(); });
@@ -80,10 +80,20 @@ absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const MapInfo& info, co
 
 MapStore::~MapStore() { (void)Close(); }
 
+void MapStore::Warn(const std::string& message) const {
+  if (options_.log_warning) {
+    options_.log_warning(message);
+  } else {
+    std::fprintf(stderr, "fremen storage: warning: %s\n", message.c_str());
+  }
+}
+
 absl::Status MapStore::Recover() {
-  uint64_t from = UINT64_MAX;
+  // Replay starts after the oldest checkpoint; new records start above the newest (the LSN floor).
+  uint64_t from = UINT64_MAX, newest = 0;
   for (const auto& shard : shards_) {
     from = std::min(from, shard->checkpoint_lsn());
+    newest = std::max(newest, shard->checkpoint_lsn());
     dedup_.MergeFrom(shard->checkpoint_dedup());
   }
   auto replayed = ReplayWal(dir_ + "/wal", from, [&](uint64_t lsn, std::span<const uint8_t> payload) -> absl::Status {
@@ -113,14 +123,29 @@ absl::Status MapStore::Recover() {
       shards_[s]->ApplyLabels(mine);
     }
     return absl::OkStatus();
-  });
+  }, options_.env);
   if (!replayed.ok()) return replayed.status();
+  // A checkpoint is only written once its records are durable, and the log is dropped only once
+  // every shard has it: a shard behind the newest checkpoint whose log stops short of it lacks
+  // records that existed.
+  if (replayed->last_lsn < newest && from < newest) {
+    return absl::DataLossError(absl::StrCat("the write-ahead log ends at LSN ", replayed->last_lsn,
+                                            " but a shard checkpointed up to LSN ", newest, " while another stopped at ",
+                                            from, ": records ", std::max(from, replayed->last_lsn) + 1, "..", newest,
+                                            " are lost for it"));
+  }
   WalOptions wal_options;
   wal_options.segment_bytes = options_.log_segment_bytes;
-  wal_options.inject_fault = options_.inject_log_fault;
+  wal_options.env = options_.env;
+  wal_options.min_next_lsn = newest + 1;
   auto wal = WalWriter::Open(dir_ + "/wal", wal_options);
   if (!wal.ok()) return wal.status();
   wal_ = *std::move(wal);
+  if (replayed->truncated_tail) {
+    Warn(absl::StrCat("map ", info_.name, ": write-ahead log ", replayed->torn_tail_file, ": cut a torn tail of ",
+                      replayed->torn_tail_bytes, " bytes at byte ", replayed->torn_tail_offset,
+                      " (a write a crash interrupted: never acknowledged)"));
+  }
   applied_dedup_ = dedup_;
   applied_lsn_ = wal_->last_lsn();
   for (const auto& shard : shards_) {
@@ -247,7 +272,7 @@ absl::StatusOr<uint64_t> MapStore::PublishModels(std::function<void(uint64_t, ui
 
 absl::Status MapStore::RecordUpdate(const UpdateRecord& record) {
   std::lock_guard lock(last_update_mutex_);
-  if (absl::Status s = WriteUpdateRecord(LastUpdatePath(dir_), record); !s.ok()) return s;
+  if (absl::Status s = WriteUpdateRecord(options_.env, LastUpdatePath(dir_), record); !s.ok()) return s;
   last_update_ = record;
   return absl::OkStatus();
 }
@@ -312,8 +337,8 @@ void MapStore::CommitLoop() {
       status = wal_->Sync();
     }
     if (!status.ok()) {
-      // Nothing of this stage is durable: answer it now; checkpoints still run (they only write
-      // what was applied before).
+      // Nothing of this stage is durable: answer it now. No checkpoint runs from now on (see
+      // StartCheckpoint); reads go on.
       Latch(status);
       for (Pending& p : stage.group) p.done(status);
       stage.group.clear();
@@ -466,6 +491,12 @@ void MapStore::FinishPublication() {
 
 void MapStore::StartCheckpoint(uint64_t lsn, std::vector<Control> waiting) {
   WaitCheckpointWrite();
+  // After a write error nothing more is written (LevelDB's bg_error_): the disk misbehaves, and
+  // every applied batch is in the log already, which the next recovery replays.
+  if (absl::Status error = WriteError(); !error.ok()) {
+    for (Control& c : waiting) c.done(error);
+    return;
+  }
   auto images = std::make_shared<std::vector<Shard::CheckpointImage>>(shards_.size());
   workers_->RunOnAll([&](uint32_t s) { (*images)[s] = shards_[s]->PrepareCheckpoint(lsn, applied_dedup_); });
   checkpoint_write_ = std::async(std::launch::async, [this, lsn, images, waiting = std::move(waiting)]() mutable {
@@ -487,6 +518,7 @@ void MapStore::WaitCheckpointWrite() {
 absl::Status MapStore::WriteCheckpoint(uint64_t lsn, std::vector<Shard::CheckpointImage>& images) {
   // No backup copies the shards while they change, so that every copy is at one log position.
   std::lock_guard backup(backup_mutex_);
+  if (absl::Status error = WriteError(); !error.ok()) return error;  // latched meanwhile: see StartCheckpoint
   std::vector<std::future<absl::Status>> writes;
   for (uint32_t s = 0; s < shards_.size(); ++s) {
     writes.push_back(std::async(std::launch::async, [this, s, &images] { return shards_[s]->WriteCheckpoint(images[s]); }));
@@ -620,10 +652,7 @@ absl::StatusOr<uint64_t> MapStore::Backup(const std::string& dir) {
   for (uint32_t i = 0; i < shards_.size(); ++i) {
     if (absl::Status s = shards_[i]->env().CopyTo(ShardDir(dir, i)); !s.ok()) return s;
   }
-  std::ofstream info(dir + "/map.info", std::ios::binary | std::ios::trunc);
-  info << EncodeMapInfo(info_);
-  info.close();
-  if (!info) return absl::InternalError(absl::StrCat("cannot write ", dir, "/map.info"));
+  if (absl::Status s = WriteFileAtomically(options_.env, dir + "/map.info", EncodeMapInfo(info_)); !s.ok()) return s;
   uint64_t bytes = 0;
   std::error_code error;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(dir, error)) {

@@ -30,6 +30,7 @@
 #include "storage/batch.h"
 #include "storage/cell_key.h"
 #include "storage/dedup_table.h"
+#include "storage/env/env.h"
 #include "storage/map_info.h"
 #include "storage/shard.h"
 #include "storage/shard_workers.h"
@@ -51,8 +52,12 @@ struct StoreOptions {
   // Observations queued but not yet applied beyond which Submit refuses (ResourceExhausted).
   // Default: 16M (about 100 MB of queued scans).
   uint64_t max_queued_observations = 16ull << 20;
-  // Fault injection for tests (see WalOptions::inject_fault). Default: none.
-  std::function<absl::Status()> inject_log_fault;
+  // The file system of the logs and of the small files a map keeps (env/env.h; LMDB does its own
+  // I/O); tests inject faults through it. REQUIRES: outlives the stores. Default: Env::Default().
+  Env* env = Env::Default();
+  // Where a store reports what it repaired on its own (a torn log tail cut at recovery): one line
+  // at a time, possibly from several threads at once. Default: none — the line goes to stderr.
+  std::function<void(const std::string&)> log_warning;
   // Observations after which a state's float spectrum is folded in double (model/wide_bodies.h).
   // Default: model::kCompactRecordLimit; tests lower it.
   uint32_t widen_records_at = model::kCompactRecordLimit;
@@ -107,7 +112,8 @@ class MapStore {
   // Stops accepting writes, finishes the queued ones and checkpoints. Idempotent.
   absl::Status Close();
   // OK, or the error that stopped all writes to the map (a failed log sync, commit or checkpoint:
-  // latched, so that nothing is acknowledged that might not be durable). Reads still work.
+  // latched, so that nothing is acknowledged that might not be durable; no checkpoint or backup
+  // is written after it either — the log holds every applied batch). Reads still work.
   absl::Status WriteError() const;
 
   // --- reads ---
@@ -159,6 +165,8 @@ class MapStore {
 
   MapStore(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings);
   absl::Status Recover();
+  // Reports a repair through StoreOptions::log_warning.
+  void Warn(const std::string& message) const;
   void CommitLoop();
   // Appends the group's new batches to the log (marking retries as duplicates); wal_mutex_ held.
   void LogGroup(std::vector<Pending>& group);

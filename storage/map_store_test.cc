@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cerrno>
 #include <thread>
 
+#include "storage/env/fault_injection_env.h"
 #include "storage/model/phasor.h"
 #include "storage/testing/scans.h"
 #include "storage/testing/temp_dir.h"
@@ -228,27 +230,27 @@ namespace {
 TEST(MapStoreTest, AFailedLogSyncIsNeverAcknowledgedAndLatches) {
   testing::TempDir dir;
   const MapInfo map = testing::GridMap("m", 16, 16, 1, 1);
-  std::atomic<bool> disk_fails = false;
+  FaultInjectionEnv env;
   StoreOptions options;
-  options.inject_log_fault = [&]() -> absl::Status {
-    return disk_fails ? absl::InternalError("injected: fdatasync failed") : absl::OkStatus();
-  };
+  options.env = &env;
   auto store = MapStore::Open(map, dir.path(), options);
   ASSERT_TRUE(store.ok());
   ASSERT_TRUE((*store)->Write(testing::SweepScan(map, 1, 0, 50)).ok());
   EXPECT_TRUE((*store)->WriteError().ok());
-  disk_fails = true;
+  env.FailSyncs(EIO);
   const auto failed = (*store)->Write(testing::SweepScan(map, 1, 1, 50));
   ASSERT_FALSE(failed.ok());
-  EXPECT_NE(failed.status().message().find("injected"), std::string::npos);
+  EXPECT_NE(failed.status().message().find("injected"), std::string::npos) << failed.status();
   EXPECT_NE((*store)->WriteError().message().find("injected"), std::string::npos);
-  disk_fails = false;  // even once the disk recovers, what was written is unknown: writes stay refused
+  env.FailSyncs(0);  // even once the disk recovers, what was written is unknown: writes stay refused
   EXPECT_FALSE((*store)->Write(testing::SweepScan(map, 1, 2, 50)).ok());
   // Reads go on, and see exactly the acknowledged batch.
   EXPECT_EQ((*store)->Stats().totals.observations, 50u);
+  env.CutPower();  // the unsynced record goes with the page cache
   store->reset();
-  auto reopened = MapStore::Open(map, dir.path(), {});
-  ASSERT_TRUE(reopened.ok());
+  env.PowerOn();
+  auto reopened = MapStore::Open(map, dir.path(), options);
+  ASSERT_TRUE(reopened.ok()) << reopened.status();
   EXPECT_EQ((*reopened)->Stats().totals.observations, 50u);
 }
 

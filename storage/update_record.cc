@@ -1,13 +1,6 @@
 #include "storage/update_record.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 
 #include "absl/strings/str_cat.h"
 #include "storage/model/varint.h"
@@ -24,10 +17,6 @@ void PutDouble(std::string* out, double v) {
   uint64_t bits;
   std::memcpy(&bits, &v, 8);
   for (int i = 0; i < 8; ++i) out->push_back(static_cast<char>(bits >> (8 * i)));
-}
-
-absl::Status Errno(const char* what, const std::string& path) {
-  return absl::InternalError(absl::StrCat("cannot ", what, " ", path, ": ", std::strerror(errno)));
 }
 
 }  // namespace
@@ -62,28 +51,15 @@ absl::StatusOr<UpdateRecord> DecodeUpdateRecord(std::string_view bytes) {
   return r;
 }
 
-absl::Status WriteUpdateRecord(const std::string& path, const UpdateRecord& record) {
-  const std::string bytes = EncodeUpdateRecord(record);
-  const std::string temporary = path + ".tmp";
-  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
-  if (fd < 0) return Errno("create", temporary);
-  const bool written = ::write(fd, bytes.data(), bytes.size()) == static_cast<ssize_t>(bytes.size()) && ::fsync(fd) == 0;
-  const absl::Status failed = written ? absl::OkStatus() : Errno("write", temporary);
-  ::close(fd);
-  if (!failed.ok()) return failed;
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) return Errno("rename to", path);
-  return absl::OkStatus();
+absl::Status WriteUpdateRecord(Env* env, const std::string& path, const UpdateRecord& record) {
+  return WriteFileAtomically(env, path, EncodeUpdateRecord(record));
 }
 
-absl::StatusOr<std::optional<UpdateRecord>> ReadUpdateRecord(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    if (errno == ENOENT) return std::optional<UpdateRecord>();
-    return Errno("read", path);
-  }
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  auto record = DecodeUpdateRecord(bytes.str());
+absl::StatusOr<std::optional<UpdateRecord>> ReadUpdateRecord(Env* env, const std::string& path) {
+  auto bytes = env->ReadFile(path);
+  if (absl::IsNotFound(bytes.status())) return std::optional<UpdateRecord>();
+  if (!bytes.ok()) return bytes.status();
+  auto record = DecodeUpdateRecord(*bytes);
   if (!record.ok()) return absl::DataLossError(absl::StrCat(path, ": ", record.status().message()));
   return std::optional<UpdateRecord>(*std::move(record));
 }

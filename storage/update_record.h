@@ -1,7 +1,8 @@
 // What a map's last update job did (issue 5: "record per map: when, how long, states updated, ε_p
 // before/after, the histogram of chosen orders"), kept by the map's store in the file
 // <map dir>/last_update so that map statistics show it across restarts.
-// Value type and pure functions, except WriteUpdateRecord/ReadUpdateRecord (file I/O); thread-safe.
+// Value type and pure functions, except WriteUpdateRecord/ReadUpdateRecord (file I/O through
+// an Env); thread-safe.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "storage/env/env.h"
 
 namespace fremen::storage {
 
@@ -31,9 +33,9 @@ std::string EncodeUpdateRecord(const UpdateRecord& record);
 // DataLoss naming the field on truncated or corrupted bytes.
 absl::StatusOr<UpdateRecord> DecodeUpdateRecord(std::string_view bytes);
 
-// Replaces `path` atomically (temporary file, fsync, rename).
-absl::Status WriteUpdateRecord(const std::string& path, const UpdateRecord& record);
+// Replaces `path` atomically and durably (WriteFileAtomically).
+absl::Status WriteUpdateRecord(Env* env, const std::string& path, const UpdateRecord& record);
 // nullopt when the file does not exist; DataLoss when it cannot be decoded.
-absl::StatusOr<std::optional<UpdateRecord>> ReadUpdateRecord(const std::string& path);
+absl::StatusOr<std::optional<UpdateRecord>> ReadUpdateRecord(Env* env, const std::string& path);
 
 }  // namespace fremen::storage

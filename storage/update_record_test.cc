@@ -23,14 +23,14 @@ UpdateRecord Sample() {
 TEST(UpdateRecordTest, RoundTripsThroughItsFile) {
   testing::TempDir dir;
   const std::string path = dir.path() + "/last_update";
-  auto missing = ReadUpdateRecord(path);
+  auto missing = ReadUpdateRecord(Env::Default(), path);
   ASSERT_TRUE(missing.ok()) << missing.status();
   EXPECT_FALSE(missing->has_value());
-  ASSERT_TRUE(WriteUpdateRecord(path, Sample()).ok());
+  ASSERT_TRUE(WriteUpdateRecord(Env::Default(), path, Sample()).ok());
   UpdateRecord second = Sample();
   second.states_updated = 0;
-  ASSERT_TRUE(WriteUpdateRecord(path, second).ok());  // replaces the first
-  auto read = ReadUpdateRecord(path);
+  ASSERT_TRUE(WriteUpdateRecord(Env::Default(), path, second).ok());  // replaces the first
+  auto read = ReadUpdateRecord(Env::Default(), path);
   ASSERT_TRUE(read.ok()) << read.status();
   ASSERT_TRUE(read->has_value());
   EXPECT_EQ(**read, second);

@@ -1,15 +1,13 @@
 #include "storage/wal/wal.h"
 
-#include <dirent.h>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cinttypes>
 #include <cstring>
+#include <optional>
+#include <string_view>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -20,12 +18,6 @@ namespace {
 
 constexpr size_t kRecordHeader = 16;  // length, CRC, LSN
 constexpr uint32_t kMaxPayload = 256u << 20;
-
-absl::Status ErrnoStatus(const std::string& what) {
-  const int e = errno;
-  const std::string message = absl::StrCat(what, ": ", std::strerror(e));
-  return e == ENOSPC ? absl::ResourceExhaustedError(message) : absl::InternalError(message);
-}
 
 void PutU32(std::vector<uint8_t>& out, uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
@@ -55,95 +47,124 @@ std::string SegmentPath(const std::string& dir, uint64_t first_lsn) {
   return absl::StrFormat("%s/wal-%020d.log", dir, first_lsn);
 }
 
-// First LSNs of the segments in dir, oldest first.
-absl::StatusOr<std::vector<uint64_t>> ListSegments(const std::string& dir) {
+using RecordFn = std::function<absl::Status(uint64_t, std::span<const uint8_t>)>;
+
+// First LSNs of the segments in dir, oldest first. Only names the writer makes count: a stray
+// "wal-….log.tmp" or an editor's backup is no segment.
+absl::StatusOr<std::vector<uint64_t>> ListSegments(Env* env, const std::string& dir) {
   std::vector<uint64_t> firsts;
-  DIR* d = opendir(dir.c_str());
-  if (!d) {
-    if (errno == ENOENT) return firsts;
-    return ErrnoStatus(absl::StrCat("opendir ", dir));
+  auto names = env->ListDir(dir);
+  if (absl::IsNotFound(names.status())) return firsts;
+  if (!names.ok()) return names.status();
+  constexpr std::string_view kPrefix = "wal-", kSuffix = ".log";
+  constexpr size_t kDigits = 20;
+  for (const std::string& name : *names) {
+    if (name.size() != kPrefix.size() + kDigits + kSuffix.size() || !name.starts_with(kPrefix) ||
+        !name.ends_with(kSuffix)) {
+      continue;
+    }
+    const std::string_view digits = std::string_view(name).substr(kPrefix.size(), kDigits);
+    if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) continue;
+    uint64_t first = 0;
+    for (char c : digits) first = first * 10 + static_cast<uint64_t>(c - '0');
+    firsts.push_back(first);
   }
-  while (dirent* e = readdir(d)) {
-    uint64_t first;
-    char tail;
-    if (std::sscanf(e->d_name, "wal-%20" SCNu64 ".lo%c", &first, &tail) == 2 && tail == 'g') firsts.push_back(first);
-  }
-  closedir(d);
   std::sort(firsts.begin(), firsts.end());
   return firsts;
 }
 
-absl::StatusOr<std::vector<uint8_t>> ReadFile(const std::string& path) {
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return ErrnoStatus(absl::StrCat("open ", path));
-  std::vector<uint8_t> data;
-  uint8_t chunk[1 << 16];
-  for (;;) {
-    const ssize_t n = read(fd, chunk, sizeof chunk);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      absl::Status s = ErrnoStatus(absl::StrCat("read ", path));
-      close(fd);
-      return s;
-    }
-    if (n == 0) break;
-    data.insert(data.end(), chunk, chunk + n);
-  }
-  close(fd);
-  return data;
+struct Record {
+  size_t pos = 0;
+  uint64_t lsn = 0;
+  std::span<const uint8_t> payload;
+};
+
+// The record at data[pos] if it is complete and its CRC holds; `plausible` vets the LSN before the
+// CRC is computed (scanning forward tries every byte).
+template <typename Plausible>
+std::optional<Record> IntactRecordAt(std::span<const uint8_t> data, size_t pos, Plausible plausible) {
+  if (data.size() - pos < kRecordHeader) return std::nullopt;
+  const uint32_t length = GetU32(&data[pos]);
+  if (length > kMaxPayload || data.size() - pos - kRecordHeader < length) return std::nullopt;
+  const uint64_t lsn = GetU64(&data[pos + 8]);
+  if (!plausible(lsn)) return std::nullopt;
+  const std::span<const uint8_t> payload = data.subspan(pos + kRecordHeader, length);
+  if (GetU32(&data[pos + 4]) != RecordCrc(&data[pos + 8], payload)) return std::nullopt;
+  return Record{pos, lsn, payload};
 }
 
-absl::Status SyncDir(const std::string& dir) {
-  const int fd = open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) return ErrnoStatus(absl::StrCat("open ", dir));
-  const int rc = fsync(fd);
-  close(fd);
-  return rc == 0 ? absl::OkStatus() : ErrnoStatus(absl::StrCat("fsync ", dir));
+// The first intact record at or after `from` whose LSN could follow `expected` in this segment (a
+// record is at least a header long, so no later LSN fits in the bytes left).
+std::optional<Record> FindIntactRecord(std::span<const uint8_t> data, size_t from, uint64_t expected) {
+  const uint64_t most = expected + (data.size() - std::min(from, data.size())) / kRecordHeader;
+  for (size_t pos = from; pos + kRecordHeader <= data.size(); ++pos) {
+    if (auto r = IntactRecordAt(data, pos, [&](uint64_t lsn) { return lsn >= expected && lsn <= most; })) return r;
+  }
+  return std::nullopt;
 }
 
 struct SegmentScan {
-  uint64_t intact_bytes = 0;  // length of the prefix made of intact records
-  bool torn = false;
+  enum class End { kClean, kTornTail, kCorrupt };
+  End end = End::kClean;
+  uint64_t intact_bytes = 0;  // the prefix made of intact records in sequence
+  std::string damage;         // kCorrupt: what is wrong where
 };
 
-// Walks the records of one segment whose first record must carry `expected_lsn`.
-absl::StatusOr<SegmentScan> ScanSegment(const std::vector<uint8_t>& data, uint64_t& expected_lsn, uint64_t after_lsn,
-                                        const std::function<absl::Status(uint64_t, std::span<const uint8_t>)>& f,
-                                        uint64_t& delivered) {
+// Walks the records of one segment whose first record must carry `expected_lsn`, passing those
+// after `after_lsn` to f (if any). Stops at the first record that is not intact and in sequence,
+// and tells a torn tail (nothing intact after it) from corruption.
+absl::StatusOr<SegmentScan> ScanSegment(const std::string& path, std::span<const uint8_t> data, uint64_t& expected_lsn,
+                                        uint64_t after_lsn, const RecordFn& f, uint64_t& delivered) {
   SegmentScan scan;
   size_t pos = 0;
   while (pos < data.size()) {
-    if (data.size() - pos < kRecordHeader) break;
-    const uint32_t length = GetU32(&data[pos]);
-    if (length > kMaxPayload || data.size() - pos - kRecordHeader < length) break;
-    const uint64_t lsn = GetU64(&data[pos + 8]);
-    const std::span<const uint8_t> payload(&data[pos + kRecordHeader], length);
-    if (GetU32(&data[pos + 4]) != RecordCrc(&data[pos + 8], payload) || lsn != expected_lsn) break;
-    if (lsn > after_lsn) {
-      if (absl::Status s = f(lsn, payload); !s.ok()) return s;
+    const auto record = IntactRecordAt(data, pos, [](uint64_t) { return true; });
+    if (!record || record->lsn != expected_lsn) break;
+    if (f && record->lsn > after_lsn) {
+      if (absl::Status s = f(record->lsn, record->payload); !s.ok()) return s;
       ++delivered;
     }
     ++expected_lsn;
-    pos += kRecordHeader + length;
+    pos += kRecordHeader + record->payload.size();
   }
   scan.intact_bytes = pos;
-  scan.torn = pos < data.size();
+  if (pos == data.size()) return scan;
+  const std::string where =
+      absl::StrCat("write-ahead log ", path, ": record at byte ", pos, " (LSN ", expected_lsn, ")");
+  if (auto out_of_sequence = IntactRecordAt(data, pos, [](uint64_t) { return true; })) {
+    scan.end = SegmentScan::End::kCorrupt;
+    scan.damage = absl::StrCat(where, " is intact but carries LSN ", out_of_sequence->lsn, "; nothing was cut");
+  } else if (auto next = FindIntactRecord(data, pos + 1, expected_lsn)) {
+    scan.end = SegmentScan::End::kCorrupt;
+    scan.damage = absl::StrCat(where, " is damaged and an intact record (LSN ", next->lsn, ") follows at byte ",
+                               next->pos, ": corruption, not a torn write; nothing was cut");
+  } else {
+    scan.end = SegmentScan::End::kTornTail;
+  }
   return scan;
 }
 
+std::span<const uint8_t> Bytes(const std::string& s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
+
 }  // namespace
 
-absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after_lsn,
-                                          const std::function<absl::Status(uint64_t, std::span<const uint8_t>)>& f) {
+absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after_lsn, const RecordFn& f, Env* env) {
   WalReplayResult result;
-  auto firsts = ListSegments(dir);
+  auto firsts = ListSegments(env, dir);
   if (!firsts.ok()) return firsts.status();
   uint64_t expected = firsts->empty() ? 1 : firsts->front();
   for (size_t i = 0; i < firsts->size(); ++i) {
     const uint64_t first = (*firsts)[i];
+    const std::string path = SegmentPath(dir, first);
     if (first != expected) {
-      return absl::DataLossError(absl::StrCat("write-ahead log ", dir, ": segment ", first, " does not follow LSN ",
-                                              expected - 1, " (a segment is missing)"));
+      // A recovery whose log ended below its checkpoints opens a new segment at its LSN floor: the
+      // LSNs skipped are covered by the checkpoint. Any other gap, or an overlap, is damage.
+      if (first < expected || first - 1 > after_lsn) {
+        return absl::DataLossError(absl::StrCat("write-ahead log ", path, ": starts at LSN ", first,
+                                                " but the log before it ends at LSN ", expected - 1,
+                                                first < expected ? " (segments overlap)" : " (a segment is missing)"));
+      }
+      expected = first;
     }
     const bool last = i + 1 == firsts->size();
     // Segments wholly covered by the checkpoint need no reading, only their LSN range.
@@ -151,16 +172,22 @@ absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after
       expected = (*firsts)[i + 1];
       continue;
     }
-    auto data = ReadFile(SegmentPath(dir, first));
+    auto data = env->ReadFile(path);
     if (!data.ok()) return data.status();
-    auto scan = ScanSegment(*data, expected, after_lsn, f, result.records);
+    auto scan = ScanSegment(path, Bytes(*data), expected, after_lsn, f, result.records);
     if (!scan.ok()) return scan.status();
-    if (scan->torn) {
+    if (scan->end == SegmentScan::End::kCorrupt) return absl::DataLossError(scan->damage);
+    if (scan->end == SegmentScan::End::kTornTail) {
       if (!last) {
-        return absl::DataLossError(absl::StrCat("write-ahead log ", SegmentPath(dir, first), ": corrupt record at byte ",
-                                                scan->intact_bytes, " before the end of the log"));
+        return absl::DataLossError(absl::StrCat("write-ahead log ", path, ": record at byte ", scan->intact_bytes,
+                                                " (LSN ", expected,
+                                                ") is damaged or incomplete and newer segments "
+                                                "follow: corruption, not a torn write"));
       }
       result.truncated_tail = true;
+      result.torn_tail_file = path;
+      result.torn_tail_offset = scan->intact_bytes;
+      result.torn_tail_bytes = data->size() - scan->intact_bytes;
     }
   }
   result.last_lsn = expected - 1;
@@ -168,59 +195,64 @@ absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after
 }
 
 absl::StatusOr<std::unique_ptr<WalWriter>> WalWriter::Open(const std::string& dir, const WalOptions& options) {
-  if (mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) return ErrnoStatus(absl::StrCat("mkdir ", dir));
+  Env* env = options.env;
+  if (absl::Status s = env->CreateDir(dir); !s.ok()) return s;
   auto writer = std::unique_ptr<WalWriter>(new WalWriter(dir, options));
-  auto firsts = ListSegments(dir);
+  auto firsts = ListSegments(env, dir);
   if (!firsts.ok()) return firsts.status();
+  const uint64_t floor = std::max<uint64_t>(options.min_next_lsn, 1);
   if (firsts->empty()) {
-    if (absl::Status s = writer->OpenSegment(1); !s.ok()) return s;
+    if (absl::Status s = writer->OpenSegment(floor); !s.ok()) return s;
+    writer->next_lsn_ = floor;
+    writer->durable_lsn_ = floor - 1;
     return writer;
   }
-  // Sizes of the live segments; the last one is cut after its last intact record.
-  for (size_t i = 0; i < firsts->size(); ++i) {
-    struct stat st;
-    const std::string path = SegmentPath(dir, (*firsts)[i]);
-    if (stat(path.c_str(), &st) != 0) return ErrnoStatus(absl::StrCat("stat ", path));
-    writer->segments_.push_back({(*firsts)[i], static_cast<uint64_t>(st.st_size)});
+  for (const uint64_t first : *firsts) {
+    auto size = env->FileSize(SegmentPath(dir, first));
+    if (!size.ok()) return size.status();
+    writer->segments_.push_back({first, *size});
   }
+  // Only the newest segment is read: older ones are the recovery's business (ReplayWal), and most
+  // are covered by the checkpoint anyway.
   const uint64_t last_first = firsts->back();
   const std::string last_path = SegmentPath(dir, last_first);
+  auto data = env->ReadFile(last_path);
+  if (!data.ok()) return data.status();
   uint64_t expected = last_first;
   uint64_t ignored = 0;
-  auto data = ReadFile(last_path);
-  if (!data.ok()) return data.status();
-  auto scan = ScanSegment(*data, expected, UINT64_MAX, [](uint64_t, auto) { return absl::OkStatus(); }, ignored);
+  auto scan = ScanSegment(last_path, Bytes(*data), expected, UINT64_MAX, nullptr, ignored);
   if (!scan.ok()) return scan.status();
-  if (scan->torn && truncate(last_path.c_str(), static_cast<off_t>(scan->intact_bytes)) != 0) {
-    return ErrnoStatus(absl::StrCat("truncate ", last_path));
+  if (scan->end == SegmentScan::End::kCorrupt) return absl::DataLossError(scan->damage);
+  if (scan->end == SegmentScan::End::kTornTail) {
+    if (absl::Status s = env->Truncate(last_path, scan->intact_bytes); !s.ok()) return s;
   }
   writer->segments_.back().bytes = scan->intact_bytes;
-  writer->fd_ = open(last_path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
-  if (writer->fd_ < 0) return ErrnoStatus(absl::StrCat("open ", last_path));
-  if (scan->torn && fdatasync(writer->fd_) != 0) return ErrnoStatus(absl::StrCat("fdatasync ", last_path));
+  auto file = env->NewAppendableFile(last_path);
+  if (!file.ok()) return file.status();
+  writer->file_ = *std::move(file);
   writer->segment_size_ = scan->intact_bytes;
-  // Only the last segment is read: older ones are the recovery's business (ReplayWal), and most
-  // are covered by the checkpoint anyway.
   writer->next_lsn_ = expected;
-  writer->durable_lsn_ = expected - 1;
   for (const Segment& s : writer->segments_) writer->bytes_ += s.bytes;
+  if (writer->next_lsn_ < floor) {
+    // The log ends below a checkpoint (its tail was lost or cut): new records start at the floor,
+    // in a segment named after it, so that none is taken for checkpointed.
+    if (absl::Status s = writer->OpenSegment(floor); !s.ok()) return s;
+    writer->next_lsn_ = floor;
+  }
+  writer->durable_lsn_ = writer->next_lsn_ - 1;
   return writer;
 }
 
 WalWriter::~WalWriter() {
-  if (fd_ >= 0) close(fd_);
+  if (file_) (void)file_->Close();
 }
 
 absl::Status WalWriter::OpenSegment(uint64_t first_lsn) {
-  const std::string path = SegmentPath(dir_, first_lsn);
-  const int fd = open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_EXCL | O_CLOEXEC, 0640);
-  if (fd < 0) return ErrnoStatus(absl::StrCat("create ", path));
-  if (absl::Status s = SyncDir(dir_); !s.ok()) {
-    close(fd);
-    return s;
-  }
-  if (fd_ >= 0) close(fd_);
-  fd_ = fd;
+  auto file = env_->NewWritableFile(SegmentPath(dir_, first_lsn));
+  if (!file.ok()) return file.status();
+  if (absl::Status s = env_->SyncDir(dir_); !s.ok()) return s;
+  if (file_) (void)file_->Close();  // synced already: every byte in it was acknowledged
+  file_ = *std::move(file);
   segment_size_ = 0;
   segments_.push_back({first_lsn, 0});
   return absl::OkStatus();
@@ -241,19 +273,13 @@ uint64_t WalWriter::Append(std::span<const uint8_t> payload) {
 absl::Status WalWriter::Sync() {
   if (!latched_.ok()) return latched_;
   if (buffer_.empty()) return absl::OkStatus();
-  absl::Status status = options_.inject_fault ? options_.inject_fault() : absl::OkStatus();
-  if (status.ok() && segment_size_ >= options_.segment_bytes) status = OpenSegment(first_buffered_lsn_);
-  size_t written = 0;
-  while (status.ok() && written < buffer_.size()) {
-    const ssize_t n = write(fd_, buffer_.data() + written, buffer_.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) status = ErrnoStatus("write to the write-ahead log");
-    else written += static_cast<size_t>(n);
-  }
-  if (status.ok() && fdatasync(fd_) != 0) status = ErrnoStatus("fdatasync of the write-ahead log");
+  absl::Status status;
+  if (segment_size_ >= options_.segment_bytes) status = OpenSegment(first_buffered_lsn_);
+  if (status.ok()) status = file_->Append(buffer_);
+  if (status.ok()) status = file_->Sync();
   if (!status.ok()) {
-    latched_ = status;
-    return status;
+    latched_ = absl::Status(status.code(), absl::StrCat("write-ahead log: ", status.message()));
+    return latched_;
   }
   segment_size_ += buffer_.size();
   segments_.back().bytes += buffer_.size();
@@ -266,7 +292,7 @@ absl::Status WalWriter::Sync() {
 absl::Status WalWriter::DropThrough(uint64_t lsn) {
   while (segments_.size() > 1 && segments_[1].first_lsn - 1 <= lsn) {
     const std::string path = SegmentPath(dir_, segments_.front().first_lsn);
-    if (unlink(path.c_str()) != 0 && errno != ENOENT) return ErrnoStatus(absl::StrCat("unlink ", path));
+    if (absl::Status s = env_->Unlink(path); !s.ok() && !absl::IsNotFound(s)) return s;
     bytes_ -= segments_.front().bytes;
     segments_.erase(segments_.begin());
   }

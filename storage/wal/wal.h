@@ -4,9 +4,17 @@
 //
 // Files: <dir>/wal-<first LSN, 20 digits>.log, rolled over at Options::segment_bytes. A record is
 //   u32 payload length | u32 CRC-32 of (LSN, payload) | u64 LSN | payload        (little-endian)
-// LSNs are consecutive from 1. A torn or corrupt tail (a crash mid-write: never acknowledged, as
-// acknowledgements wait for Sync) ends the log: replay stops there and the writer truncates it.
-// Corruption before the tail — a bad record followed by good ones — is reported as DataLoss.
+// LSNs are consecutive within the log, from 1 or from the segment a recovery opened at its LSN
+// floor (WalOptions::min_next_lsn); a gap between segments is legitimate only where a checkpoint
+// covers every missing LSN.
+//
+// Torn tail or corruption (storage/README.md, "Torn tail and corruption"): only an incomplete
+// record at the very end of the newest segment — header or payload running past the end of the
+// file, or a last record whose CRC fails with no intact record after it — is a torn tail: a
+// crash mid-write, never acknowledged (acknowledgements wait for Sync). Replay stops before it and
+// reports its size; the writer cuts it. Anything else — a damaged record followed by bytes that
+// parse as an intact record with a plausible LSN, a damaged older segment, an intact record out of
+// sequence — is corruption: DataLoss naming the file, byte offset and LSN, and nothing is cut.
 //
 // Thread-safety: WalWriter is used by one thread (the map's committer); Replay by one thread
 // before the writer opens.
@@ -15,7 +23,6 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
-#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -23,6 +30,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "storage/env/env.h"
 
 namespace fremen::storage {
 
@@ -30,32 +38,46 @@ struct WalOptions {
   // A new segment starts once the current one passes this size; checkpoints delete whole
   // segments, so smaller segments free space sooner at the cost of more files. Default: 64 MiB.
   uint64_t segment_bytes = 64ull << 20;
-  // Fault injection for tests: called before each write+sync; an error is treated exactly like a
-  // failed write (it latches). Default: none.
-  std::function<absl::Status()> inject_fault;
+  // Where the segments are read and written; tests inject faults through it.
+  // REQUIRES: outlives the writer. Default: Env::Default().
+  Env* env = Env::Default();
+  // The LSN floor: the next record gets at least this LSN. A recovery passes its highest checkpoint
+  // LSN + 1, so that no new record can fall at or below a checkpoint (a later recovery would skip
+  // it as checkpointed). When the log ends below it, a new segment starts at the floor.
+  // Default: 1.
+  uint64_t min_next_lsn = 1;
 };
 
 struct WalReplayResult {
-  uint64_t last_lsn = 0;       // the last intact record (0: none)
-  uint64_t records = 0;        // records passed to the callback
-  bool truncated_tail = false; // a torn/corrupt tail was found (and will be cut by the writer)
+  uint64_t last_lsn = 0;        // the last intact record (0: none)
+  uint64_t records = 0;         // records passed to the callback
+  bool truncated_tail = false;  // a torn tail was found (the writer cuts it when it opens)
+  // Where the torn tail starts and how long it is, for the warning the caller logs.
+  std::string torn_tail_file;
+  uint64_t torn_tail_offset = 0;
+  uint64_t torn_tail_bytes = 0;
 };
 
 // Calls f(lsn, payload) for every intact record with LSN > after_lsn, in order. f's error stops the
-// replay and is returned.
+// replay and is returned. Corruption (see above) is DataLoss; a gap between segments is DataLoss
+// unless after_lsn covers it.
 absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after_lsn,
-                                          const std::function<absl::Status(uint64_t, std::span<const uint8_t>)>& f);
+                                          const std::function<absl::Status(uint64_t, std::span<const uint8_t>)>& f,
+                                          Env* env = Env::Default());
 
 class WalWriter {
  public:
-  // Opens the log for appending after its last intact record, cutting a torn tail.
+  // Opens the log for appending after its last intact record (or at options.min_next_lsn, if
+  // higher), cutting a torn tail of the newest segment. Only the newest segment is read: corruption
+  // there is DataLoss and nothing is cut; older segments are ReplayWal's business.
   static absl::StatusOr<std::unique_ptr<WalWriter>> Open(const std::string& dir, const WalOptions& options);
   ~WalWriter();
 
   // Buffers one record; returns its LSN. Nothing is durable until Sync() returns OK.
   uint64_t Append(std::span<const uint8_t> payload);
   // Writes the buffered records and fdatasyncs. A failure latches: every later Sync fails too, so
-  // that nothing is acknowledged after an I/O error (the bytes on disk are unknown).
+  // that nothing is acknowledged after an I/O error (the bytes on disk are unknown). ENOSPC is
+  // ResourceExhausted (see env.h).
   absl::Status Sync();
   // Deletes segments whose records all have LSN ≤ lsn (the checkpoint covers them).
   absl::Status DropThrough(uint64_t lsn);
@@ -67,12 +89,13 @@ class WalWriter {
   uint64_t bytes() const { return bytes_.load(std::memory_order_relaxed); }
 
  private:
-  WalWriter(std::string dir, WalOptions options) : dir_(std::move(dir)), options_(options) {}
+  WalWriter(std::string dir, WalOptions options) : dir_(std::move(dir)), options_(options), env_(options.env) {}
   absl::Status OpenSegment(uint64_t first_lsn);
 
   std::string dir_;
   WalOptions options_;
-  int fd_ = -1;
+  Env* const env_;
+  std::unique_ptr<WritableFile> file_;  // the newest segment
   uint64_t segment_size_ = 0;
   uint64_t next_lsn_ = 1;
   std::atomic<uint64_t> durable_lsn_ = 0;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "absl/strings/str_cat.h"
 #include "storage/testing/temp_dir.h"
 
 namespace fremen::storage {
@@ -84,6 +85,9 @@ TEST(WalTest, ATornTailIsCutAndTheLogGoesOn) {
   WalReplayResult result;
   EXPECT_EQ(ReplayAll(dir.path(), 0, &result).size(), 19u);
   EXPECT_TRUE(result.truncated_tail);
+  EXPECT_EQ(result.torn_tail_file, segment);
+  EXPECT_EQ(result.torn_tail_bytes, 16 + Payload(20).size() - 5);
+  EXPECT_EQ(result.torn_tail_offset, size - (16 + Payload(20).size()));
   auto wal = WalWriter::Open(dir.path(), {});
   ASSERT_TRUE(wal.ok()) << wal.status();
   EXPECT_EQ((*wal)->Append(Payload(20)), 20u);
@@ -144,6 +148,135 @@ TEST(WalTest, CorruptionBeforeTheTailIsDataLoss) {
   auto writer = WalWriter::Open(dir.path(), options);
   ASSERT_TRUE(writer.ok());
   EXPECT_EQ((*writer)->Append(Payload(51)), 51u);
+}
+
+std::vector<std::string> Segments(const std::string& dir) {
+  std::vector<std::string> segments;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) segments.push_back(e.path());
+  std::sort(segments.begin(), segments.end());
+  return segments;
+}
+
+std::string Contents(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void Overwrite(const std::string& path, uint64_t offset, const std::string& bytes) {
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekp(static_cast<std::streamoff>(offset));
+  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// Writes records 1..n, each synced, into one segment.
+void WriteRecords(const std::string& dir, uint64_t n) {
+  auto wal = WalWriter::Open(dir, {});
+  ASSERT_TRUE(wal.ok()) << wal.status();
+  for (uint64_t i = 1; i <= n; ++i) {
+    (*wal)->Append(Payload(i));
+    ASSERT_TRUE((*wal)->Sync().ok());
+  }
+}
+
+// Issue 11, case 1: a bad record of the last segment was taken for a torn tail, and everything
+// after it was cut.
+TEST(WalTest, CorruptionIsNotATornTailAMidSegmentFlipIsDataLossAndNothingIsCut) {
+  testing::TempDir dir;
+  WriteRecords(dir.path(), 40);
+  const std::string segment = Segments(dir.path()).front();
+  uint64_t offset = 0;  // of record 20
+  for (uint64_t i = 1; i < 20; ++i) offset += 16 + Payload(i).size();
+  Overwrite(segment, offset + 3, std::string(16, '\x5a'));  // 16 bytes flipped in its header and payload
+  const std::string damaged = Contents(segment);
+  auto replay = ReplayWal(dir.path(), 0, [](uint64_t, auto) { return absl::OkStatus(); });
+  ASSERT_FALSE(replay.ok());
+  EXPECT_TRUE(absl::IsDataLoss(replay.status())) << replay.status();
+  const std::string message(replay.status().message());
+  EXPECT_NE(message.find(segment), std::string::npos) << message;
+  EXPECT_NE(message.find(absl::StrCat("byte ", offset)), std::string::npos) << message;
+  EXPECT_NE(message.find("LSN 20"), std::string::npos) << message;
+  // The writer refuses too, and cuts nothing.
+  auto writer = WalWriter::Open(dir.path(), {});
+  ASSERT_FALSE(writer.ok());
+  EXPECT_TRUE(absl::IsDataLoss(writer.status())) << writer.status();
+  EXPECT_EQ(Contents(segment), damaged);
+  EXPECT_EQ(Segments(dir.path()).size(), 1u);
+}
+
+TEST(WalTest, AnIntactRecordOutOfSequenceIsCorruption) {
+  testing::TempDir dir;
+  WriteRecords(dir.path(), 3);
+  testing::TempDir other;
+  WriteRecords(other.path(), 5);
+  // Record 5 of another log appended: intact, but LSN 5 where 4 is due.
+  const std::string foreign = Contents(Segments(other.path()).front());
+  uint64_t offset = 0;
+  for (uint64_t i = 1; i < 5; ++i) offset += 16 + Payload(i).size();
+  std::ofstream(Segments(dir.path()).front(), std::ios::binary | std::ios::app) << foreign.substr(offset);
+  auto replay = ReplayWal(dir.path(), 0, [](uint64_t, auto) { return absl::OkStatus(); });
+  ASSERT_FALSE(replay.ok());
+  EXPECT_TRUE(absl::IsDataLoss(replay.status())) << replay.status();
+  EXPECT_FALSE(WalWriter::Open(dir.path(), {}).ok());
+}
+
+// Judged a torn tail: a crash can leave the file's size written and its last page not (zeros), or a
+// last record half old bytes; nothing after it was ever acknowledged.
+TEST(WalTest, ALastRecordWithABadCrcOrZerosAtTheEndIsATornTail) {
+  for (const bool zeros : {false, true}) {
+    testing::TempDir dir;
+    WriteRecords(dir.path(), 10);
+    const std::string segment = Segments(dir.path()).front();
+    const uint64_t size = std::filesystem::file_size(segment);
+    if (zeros) {
+      std::filesystem::resize_file(segment, size + 4096);
+    } else {
+      Overwrite(segment, size - 2, "\x01\x02");  // in the last record's payload
+    }
+    WalReplayResult result;
+    EXPECT_EQ(ReplayAll(dir.path(), 0, &result).size(), zeros ? 10u : 9u) << zeros;
+    EXPECT_TRUE(result.truncated_tail);
+    EXPECT_EQ(result.torn_tail_bytes, zeros ? 4096 : 16 + Payload(10).size());
+    auto wal = WalWriter::Open(dir.path(), {});
+    ASSERT_TRUE(wal.ok()) << wal.status();
+    EXPECT_EQ((*wal)->last_lsn(), zeros ? 10u : 9u);
+    EXPECT_EQ(std::filesystem::file_size(segment), zeros ? size : size - 16 - Payload(10).size());
+  }
+}
+
+// Issue 11, case 2: the writer resumed below the shards' checkpoint LSN, and a later recovery
+// skipped the new records as checkpointed.
+TEST(WalTest, TheWriterNeverGoesBelowItsLsnFloor) {
+  testing::TempDir dir;
+  WriteRecords(dir.path(), 10);
+  WalOptions options;
+  options.min_next_lsn = 31;  // a checkpoint at LSN 30, and the log lost its records 11..30
+  {
+    auto wal = WalWriter::Open(dir.path(), options);
+    ASSERT_TRUE(wal.ok()) << wal.status();
+    EXPECT_EQ((*wal)->last_lsn(), 30u);
+    EXPECT_EQ((*wal)->Append(Payload(31)), 31u);
+    ASSERT_TRUE((*wal)->Sync().ok());
+  }
+  const auto segments = Segments(dir.path());
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_NE(segments.back().find("wal-00000000000000000031.log"), std::string::npos) << segments.back();
+  // The gap lies below the checkpoint: replay after it goes on; a replay that needs the gap fails.
+  EXPECT_EQ(ReplayAll(dir.path(), 30), std::vector<uint64_t>{31});
+  auto needs_gap = ReplayWal(dir.path(), 20, [](uint64_t, auto) { return absl::OkStatus(); });
+  ASSERT_FALSE(needs_gap.ok());
+  EXPECT_TRUE(absl::IsDataLoss(needs_gap.status())) << needs_gap.status();
+  EXPECT_NE(needs_gap.status().message().find("missing"), std::string::npos) << needs_gap.status();
+  // Reopened, the log continues above the floor; a floor already passed changes nothing.
+  options.min_next_lsn = 5;
+  auto wal = WalWriter::Open(dir.path(), options);
+  ASSERT_TRUE(wal.ok());
+  EXPECT_EQ((*wal)->Append(Payload(32)), 32u);
+  // A log removed altogether starts at the floor too.
+  testing::TempDir empty;
+  options.min_next_lsn = 100;
+  auto fresh = WalWriter::Open(empty.path(), options);
+  ASSERT_TRUE(fresh.ok());
+  EXPECT_EQ((*fresh)->Append(Payload(100)), 100u);
 }
 
 }  // namespace

@@ -1,0 +1,131 @@
+// A map's recovery from a damaged write-ahead log (storage/README.md, "Torn tail and corruption"):
+// the two losses of issue 11 (cases 1 and 2), pinned by name.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+
+#include "storage/map_store.h"
+#include "storage/testing/crash_image.h"
+#include "storage/testing/scans.h"
+#include "storage/testing/temp_dir.h"
+
+namespace fremen::storage {
+namespace {
+
+constexpr size_t kCells = 50;
+
+std::string OnlySegment(const std::string& map_dir) {
+  std::vector<std::string> segments;
+  for (const auto& e : std::filesystem::directory_iterator(map_dir + "/wal")) segments.push_back(e.path());
+  EXPECT_EQ(segments.size(), 1u);
+  return segments.empty() ? "" : segments.front();
+}
+
+std::string Contents(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void Overwrite(const std::string& path, uint64_t offset, const std::string& bytes) {
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekp(static_cast<std::streamoff>(offset));
+  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+StoreOptions NoCheckpointsUntilClose() {
+  StoreOptions options;
+  options.checkpoint_log_bytes = 1ull << 40;
+  return options;
+}
+
+// Before: replay took the flip for a torn tail, cut the log there and served the map without the 20
+// acknowledged batches after it.
+TEST(WalRecoveryTest, Issue11ACorruptRecordAfterAcknowledgedBatchesFailsTheMapAndCutsNothing) {
+  testing::TempDir dir, image;
+  const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
+  {
+    auto store = MapStore::Open(map, dir.path(), NoCheckpointsUntilClose());
+    ASSERT_TRUE(store.ok()) << store.status();
+    for (uint64_t i = 0; i < 40; ++i) ASSERT_TRUE((*store)->Write(testing::SweepScan(map, 1, i, kCells)).ok());
+    testing::CopyCrashImage(dir.path(), image.path());  // killed here: only the log has the batches
+  }
+  const std::string segment = OnlySegment(image.path());
+  const uint64_t size = std::filesystem::file_size(segment);
+  Overwrite(segment, size / 2, std::string(16, '\xa5'));
+  const std::string damaged = Contents(segment);
+  auto reopened = MapStore::Open(map, image.path(), {});
+  ASSERT_FALSE(reopened.ok());
+  EXPECT_TRUE(absl::IsDataLoss(reopened.status())) << reopened.status();
+  const std::string message(reopened.status().message());
+  EXPECT_NE(message.find(segment), std::string::npos) << message;
+  EXPECT_NE(message.find("byte "), std::string::npos) << message;
+  EXPECT_NE(message.find("LSN "), std::string::npos) << message;
+  EXPECT_EQ(Contents(segment), damaged) << "nothing may be cut";
+  EXPECT_EQ(OnlySegment(image.path()), segment);
+}
+
+// Before: the writer resumed at the cut record's LSN, at or below the shards' checkpoint, and the
+// next recovery skipped the new records as checkpointed (20 of 30 acknowledged batches gone).
+TEST(WalRecoveryTest, Issue11RecordsWrittenAfterARecoveryNeverFallBelowTheCheckpoint) {
+  testing::TempDir dir, image;
+  const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
+  {
+    auto store = MapStore::Open(map, dir.path(), NoCheckpointsUntilClose());
+    ASSERT_TRUE(store.ok());
+    for (uint64_t i = 0; i < 30; ++i) ASSERT_TRUE((*store)->Write(testing::SweepScan(map, 1, i, kCells)).ok());
+  }  // closed: checkpointed at LSN 30, and the log keeps its segment
+  // Bit rot in the last record, with nothing after it: judged a torn tail and cut, so that the log
+  // now ends below the checkpoint.
+  const std::string segment = OnlySegment(dir.path());
+  Overwrite(segment, std::filesystem::file_size(segment) - 2, "\x01\x02");
+  std::mutex warnings_mutex;
+  std::vector<std::string> warnings;
+  StoreOptions options = NoCheckpointsUntilClose();
+  options.log_warning = [&](const std::string& line) {
+    std::lock_guard lock(warnings_mutex);
+    warnings.push_back(line);
+  };
+  {
+    auto store = MapStore::Open(map, dir.path(), options);
+    ASSERT_TRUE(store.ok()) << store.status();
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_NE(warnings[0].find("torn tail of "), std::string::npos) << warnings[0];
+    EXPECT_NE(warnings[0].find(segment), std::string::npos) << warnings[0];
+    EXPECT_EQ((*store)->Stats().totals.observations, 30 * kCells) << "the checkpoint holds all 30";
+    for (uint64_t i = 30; i < 60; ++i) {
+      auto ack = (*store)->Write(testing::SweepScan(map, 1, i, kCells));
+      ASSERT_TRUE(ack.ok());
+      EXPECT_GT(ack->lsn, 30u) << "at or below the checkpoint LSN";
+    }
+    testing::CopyCrashImage(dir.path(),
+                            image.path());  // killed: the 30 new batches are only in the log
+  }
+  auto recovered = MapStore::Open(map, image.path(), {});
+  ASSERT_TRUE(recovered.ok()) << recovered.status();
+  EXPECT_EQ((*recovered)->Stats().totals.observations, 60 * kCells);
+}
+
+TEST(WalRecoveryTest, ALogRemovedAltogetherRestartsAboveTheCheckpoint) {
+  testing::TempDir dir, image;
+  const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
+  {
+    auto store = MapStore::Open(map, dir.path(), NoCheckpointsUntilClose());
+    ASSERT_TRUE(store.ok());
+    for (uint64_t i = 0; i < 10; ++i) ASSERT_TRUE((*store)->Write(testing::SweepScan(map, 1, i, kCells)).ok());
+  }
+  std::filesystem::remove_all(dir.path() + "/wal");
+  {
+    auto store = MapStore::Open(map, dir.path(), NoCheckpointsUntilClose());
+    ASSERT_TRUE(store.ok()) << store.status();
+    for (uint64_t i = 10; i < 20; ++i) ASSERT_TRUE((*store)->Write(testing::SweepScan(map, 1, i, kCells)).ok());
+    testing::CopyCrashImage(dir.path(), image.path());
+  }
+  auto recovered = MapStore::Open(map, image.path(), {});
+  ASSERT_TRUE(recovered.ok()) << recovered.status();
+  EXPECT_EQ((*recovered)->Stats().totals.observations, 20 * kCells);
+}
+
+}  // namespace
+}  // namespace fremen::storage
