@@ -85,9 +85,8 @@ absl::Status Daemon::Start() {
   scheduler_->Start();
   auto maps = CountMaps(*store_);
   const size_t failed = store_->FailedMaps().size();
-  Log()->info("fremend listening on {}, data in {} ({} maps{}){}", address_, config_.data_dir,
-              maps.ok() ? *maps : 0, failed == 0 ? "" : absl::StrCat(", ", failed, " failed"),
-              auth_.enabled() ? ", tokens required" : "");
+  Log()->info("fremend listening on {}, data in {} ({} maps{}){}", address_, config_.data_dir, maps.ok() ? *maps : 0,
+              failed == 0 ? "" : absl::StrCat(", ", failed, " failed"), auth_.enabled() ? ", tokens required" : "");
   return absl::OkStatus();
 }
 

@@ -1,6 +1,6 @@
 // A guard against LMDB aborting the process on a damaged file.
 //
-// LMDB trusts its pages: on some damaged ones (a zeroed branch page, a page number past the end of the file) it fails
+// LMDB trusts its pages: on some damaged ones (a zeroed page in a tree, a page number past the end of the file) it fails
 // an assertion and calls abort(), or touches memory past the mapped file (SIGBUS) — taking down every map of the
 // daemon, with only LMDB's assertion text naming no file. ProbeEnvironments walks the files in a forked child instead:
 // the child opens each environment read-only (no lock file), walks every page a reader or writer will reach — the free
@@ -8,8 +8,9 @@
 // dies or reports an LMDB error marks the file damaged; the parent only reads a pipe and waits. The cost is one pass
 // over the mapped files (page cache), which the later load repeats.
 //
-// The child runs only LMDB's C functions, write() and _exit(), so forking a process that has other threads (gRPC's) is
-// safe: nothing the child calls needs a lock another thread may hold.
+// The child runs only LMDB's C functions, write() and _exit() (LMDB's own assertion printing, which takes stdio's lock,
+// is replaced by a callback that writes to the pipe), so forking a process that has other threads (gRPC's) is safe:
+// nothing the child calls needs a lock another thread may hold, and glibc keeps malloc usable in a forked child.
 //
 // Thread-safety: a pure function; may be called from any thread (each call forks its own child).
 #pragma once
