@@ -301,5 +301,38 @@ TEST(StoreIntegrityTest, AZeroedShardPageFailsThatMapAloneNamingTheFile) {
   EXPECT_TRUE(absl::IsNotFound((*store)->Map("bad").status()));
 }
 
+// A damaged backup is refused by RestoreMap (the copy is probed and loaded before the map is listed), with the file
+// named; what the call copied is removed, nothing else.
+TEST(StoreIntegrityTest, RestoringADamagedBackupFailsNamingTheFileAndLeavesNothing) {
+  TempDir dir, backup;
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok());
+  ASSERT_TRUE((*store)->CreateMap(Generic("m")).ok());
+  Fill(**(*store)->Map("m"));
+  ASSERT_TRUE((*store)->BackupMap("m", backup.path() + "/copy").ok());
+  const std::string copy = backup.path() + "/copy/shard-0";
+  std::vector<Record> dynamic;
+  for (Record& r : ShardRecords(copy)) {
+    if (r.db == "dynamic") dynamic.push_back(std::move(r));
+  }
+  ASSERT_FALSE(dynamic.empty());
+  const std::string copy_file = copy + "/data.mdb";
+  for (const size_t at :
+       testing::FindAll(testing::ReadWholeFile(copy_file), Bytes(dynamic[dynamic.size() / 2].value))) {
+    testing::ZeroPage(copy_file, at / 4096);
+  }
+  auto restored = (*store)->RestoreMap(backup.path() + "/copy", "restored");
+  ASSERT_TRUE(absl::IsDataLoss(restored.status())) << restored.status();
+  EXPECT_NE(restored.status().message().find("is damaged: LMDB aborted reading it"), std::string::npos)
+      << restored.status();
+  EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("restored").status()));
+  EXPECT_TRUE((*store)->FailedMaps().empty());
+  size_t map_dirs = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path() + "/maps")) map_dirs += entry.is_directory();
+  EXPECT_EQ(map_dirs, 1u);                          // only "m"'s: the restore's copy is gone
+  EXPECT_TRUE(std::filesystem::exists(copy_file));  // the backup itself is left as it was
+  EXPECT_TRUE((*store)->Map("m").ok());
+}
+
 }  // namespace
 }  // namespace fremen::storage

@@ -17,6 +17,7 @@
 #include "fremen/v1/query.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "storage/lmdb/lmdb_env.h"
+#include "storage/map_info.h"
 #include "storage/store.h"
 #include "storage/testing/file_damage.h"
 #include "tests/fremend_fixture.h"
@@ -193,6 +194,53 @@ TEST_F(FremendIntegrityTest, AFlippedBitInARecordIsDataLossNamingFileAndKey) {
   EXPECT_THAT(predicted.error_message(), HasSubstr(file));
   EXPECT_THAT(predicted.error_message(), HasSubstr("database dynamic, key 0000000000000065: checksum mismatch"));
   EXPECT_EQ(response.probabilities_size(), 0);
+}
+
+// The case 3: one flipped bit changes a map's id in catalog/data.mdb. The daemon used to remove that map's
+// directory at the next start. Now the record is DATA_LOSS, the map is listed as failed, its directory is reported
+// (unknown_directories) and left, and the other map serves.
+TEST_F(FremendIntegrityTest, ACatalogBitFlipDeletesNothingAndIsReported) {
+  Connect();
+  CreateGenericMap("alpha");
+  CreateGenericMap("beta");
+  ASSERT_FALSE(HasFatalFailure());
+  StopDaemon();
+  ASSERT_TRUE(WriteBatches(data_dir(), "alpha", Scans()).ok());
+  ASSERT_TRUE(WriteBatches(data_dir(), "beta", Scans()).ok());
+  storage::MapInfo alpha;
+  {
+    auto store = storage::Store::Open(data_dir(), {});
+    ASSERT_TRUE(store.ok()) << store.status();
+    auto info = (*store)->GetMap("alpha");
+    ASSERT_TRUE(info.ok()) << info.status();
+    alpha = *info;
+  }
+  const std::string catalog = data_dir() + "/catalog/data.mdb";
+  const std::vector<size_t> copies =
+      storage::testing::FindAll(storage::testing::ReadWholeFile(catalog), Bytes(storage::EncodeMapInfo(alpha)));
+  ASSERT_FALSE(copies.empty());
+  // version | name length | "alpha" | id: the id's lowest bit.
+  for (const size_t at : copies) storage::testing::FlipBit(catalog, at + 2 + alpha.name.size(), 0);
+  const std::string alpha_dir = data_dir() + "/maps/" + std::to_string(alpha.id);
+
+  StartDaemon();
+  ASSERT_FALSE(HasFatalFailure());
+  Connect();
+  v1::PredictResponse response;
+  EXPECT_TRUE(Predict("beta", &response).ok());
+  const grpc::Status refused = Predict("alpha", &response);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::DATA_LOSS) << refused.error_message();
+  EXPECT_THAT(refused.error_message(), HasSubstr(catalog));
+  v1::GetServerStatusResponse status;
+  ASSERT_TRUE(admin_->GetServerStatus(CallContext().get(), v1::GetServerStatusRequest(), &status).ok());
+  ASSERT_EQ(status.failed_maps_size(), 1);
+  EXPECT_EQ(status.failed_maps(0).map(), "alpha");
+  EXPECT_THAT(status.failed_maps(0).error(), HasSubstr("checksum mismatch"));
+  ASSERT_EQ(status.unknown_directories_size(), 1);
+  EXPECT_EQ(status.unknown_directories(0), alpha_dir);
+  EXPECT_THAT(daemon_->Log(), HasSubstr(alpha_dir + " is not a map of the catalog"));
+  // The map's files are all there.
+  EXPECT_TRUE(std::filesystem::exists(alpha_dir + "/shard-0/data.mdb"));
 }
 
 }  // namespace
