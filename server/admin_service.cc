@@ -261,9 +261,16 @@ absl::Status AdminServiceImpl::FillStatus(v1::GetServerStatusResponse& response)
   auto maps = ListAllMaps(**store);
   if (!maps.ok()) return maps.status();
   response.set_map_count(maps->size());
+  // Maps that did not open (their calls answer the error), then maps whose writes stopped.
+  for (const storage::FailedMap& failed_map : (*store)->FailedMaps()) {
+    v1::MapFault& failed = *response.add_failed_maps();
+    failed.set_map(failed_map.name);
+    failed.set_error(failed_map.status.ToString());
+  }
+  for (const std::string& dir : (*store)->UnknownDirectories()) response.add_unknown_directories(dir);
   for (const storage::MapInfo& info : *maps) {
     auto map = (*store)->Map(info.name);
-    if (!map.ok()) continue;  // deleted meanwhile
+    if (!map.ok()) continue;  // deleted meanwhile, or failed (listed above)
     if (const absl::Status fault = (*map)->WriteError(); !fault.ok()) {
       v1::MapFault& failed = *response.add_failed_maps();
       failed.set_map(info.name);

@@ -84,8 +84,9 @@ absl::Status Daemon::Start() {
   SetServing(true);
   scheduler_->Start();
   auto maps = CountMaps(*store_);
-  Log()->info("fremend listening on {}, data in {} ({} maps){}", address_, config_.data_dir,
-              maps.ok() ? *maps : 0, auth_.enabled() ? ", tokens required" : "");
+  const size_t failed = store_->FailedMaps().size();
+  Log()->info("fremend listening on {}, data in {} ({} maps{}){}", address_, config_.data_dir, maps.ok() ? *maps : 0,
+              failed == 0 ? "" : absl::StrCat(", ", failed, " failed"), auth_.enabled() ? ", tokens required" : "");
   return absl::OkStatus();
 }
 
@@ -197,6 +198,14 @@ absl::Status Daemon::OpenStore() {
   store_ = *std::move(store);
   store_handle_.Publish(store_.get());
   store_log->info("opened in {}", absl::FormatDuration(absl::Now() - start));
+  // A map that did not open fails alone: the daemon serves the others (health stays SERVING) and
+  // says why here and in GetServerStatus' failed_maps.
+  for (const storage::FailedMap& failed : store_->FailedMaps()) {
+    store_log->error("map {} is failed and not served: {}", failed.name, failed.status.ToString());
+  }
+  for (const std::string& dir : store_->UnknownDirectories()) {
+    store_log->warn("{} is not a map of the catalog: left as it is for an operator (GetServerStatus lists it)", dir);
+  }
   return absl::OkStatus();
 }
 

@@ -39,7 +39,8 @@ absl::StatusOr<std::unique_ptr<Catalog>> Catalog::Open(const std::string& dir) {
   return std::unique_ptr<Catalog>(new Catalog(*std::move(env)));
 }
 
-absl::StatusOr<MapInfo> Catalog::Create(MapInfo info, uint32_t default_shards) {
+absl::StatusOr<MapInfo> Catalog::Create(MapInfo info, uint32_t default_shards,
+                                        const std::function<bool(uint64_t)>& id_in_use) {
   if (info.shards == 0) info.shards = default_shards;
   if (absl::Status valid = ValidateMapInfo(info); !valid.ok()) return valid;
   info.created_unix = std::time(nullptr);
@@ -47,9 +48,15 @@ absl::StatusOr<MapInfo> Catalog::Create(MapInfo info, uint32_t default_shards) {
     auto meta = txn.Db(kMetaDb);
     if (!meta.ok()) return meta.status();
     uint64_t next_id = 1;
-    if (auto stored = txn.Get(*meta, Bytes("next_id")); stored.ok() && stored->size() == 8) {
+    if (auto stored = txn.Get(*meta, Bytes("next_id")); stored.ok()) {
+      if (stored->size() != 8) {
+        return absl::DataLossError(absl::StrCat("catalog next_id is ", stored->size(), " bytes"));
+      }
       std::memcpy(&next_id, stored->data(), 8);
+    } else if (!absl::IsNotFound(stored.status())) {
+      return stored.status();  // a damaged next_id must not restart ids at 1
     }
+    while (id_in_use != nullptr && id_in_use(next_id)) ++next_id;
     info.id = next_id;
     ++next_id;
     uint8_t raw[8];
@@ -76,6 +83,9 @@ absl::StatusOr<MapInfo> Catalog::Get(const std::string& name) const {
     if (absl::IsNotFound(value.status())) return absl::OkStatus();
     if (!value.ok()) return value.status();
     result = DecodeMapInfo(View(*value));
+    if (!result.ok()) {
+      result = absl::DataLossError(absl::StrCat("catalog record \"", name, "\": ", result.status().message()));
+    }
     return absl::OkStatus();
   });
   if (!read.ok()) return read;
@@ -95,22 +105,27 @@ absl::StatusOr<MapPage> Catalog::List(size_t page_size, const std::string& page_
     after = page_token.substr(sizeof(kTokenPrefix) - 1);
   }
   MapPage page;
-  absl::Status decode_error;
   const absl::Status read = env_->Read([&](LmdbTxn& txn) -> absl::Status {
     auto maps = txn.Db(kMapsDb);
     if (absl::IsNotFound(maps.status())) return absl::OkStatus();
     if (!maps.ok()) return maps.status();
     bool more = false;
-    const absl::Status scanned = txn.Scan(*maps, Bytes(after), {}, [&](auto key, auto value) {
+    const absl::Status scanned = txn.ScanChecked(*maps, Bytes(after), {}, [&](auto key, auto value) {
       if (!after.empty() && View(key) == after) return true;  // the token's map was on the last page
       if (page.maps.size() == page_size) {
         more = true;
         return false;
       }
-      auto info = DecodeMapInfo(View(value));
+      if (!value.ok()) {
+        page.damaged.push_back({std::string(View(key)), value.status()});
+        return true;
+      }
+      auto info = DecodeMapInfo(View(*value));
       if (!info.ok()) {
-        decode_error = info.status();
-        return false;
+        const std::string name(View(key));
+        page.damaged.push_back(
+            {name, absl::DataLossError(absl::StrCat("catalog record \"", name, "\": ", info.status().message()))});
+        return true;
       }
       page.maps.push_back(*std::move(info));
       return true;
@@ -119,7 +134,6 @@ absl::StatusOr<MapPage> Catalog::List(size_t page_size, const std::string& page_
     return scanned;
   });
   if (!read.ok()) return read;
-  if (!decode_error.ok()) return decode_error;
   return page;
 }
 

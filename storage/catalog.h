@@ -1,11 +1,13 @@
 // The catalog of maps: name → MapInfo, in its own LMDB environment (<data dir>/catalog).
 //
-// Create assigns the map's id (never reused), its creation time and its default shard count; names
-// are unique. Deleting a map removes only its entry: the Store removes the map's files after, and
-// removes at start any map directory the catalog does not know (a crash between the two).
-// Thread-safety: all methods may be called concurrently (LMDB serialises the writers).
+// Create assigns the map's id (never reused), its creation time and its default shard count; names are unique. Deleting
+// a map removes only its entry: the Store removes the map's files after. A record whose checksum does not match
+// (lmdb_env.h) is never taken for another map: Get answers DataLoss naming the file and key, List leaves it out of the
+// page and reports it in `damaged`. Thread-safety: all methods may be called concurrently (LMDB serialises the
+// writers).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,10 +18,18 @@
 
 namespace fremen::storage {
 
+// A catalog record that did not verify or decode.
+struct DamagedCatalogEntry {
+  std::string key;      // the stored name (itself possibly damaged)
+  absl::Status status;  // DataLoss naming the file and key
+};
+
 struct MapPage {
   std::vector<MapInfo> maps;
   // Pass to the next List call; empty on the last page.
   std::string next_page_token;
+  // Damaged records met while listing this page, in key order; not in `maps`.
+  std::vector<DamagedCatalogEntry> damaged;
 };
 
 inline constexpr size_t kMaxPageSize = 1000;
@@ -29,9 +39,11 @@ class Catalog {
  public:
   static absl::StatusOr<std::unique_ptr<Catalog>> Open(const std::string& dir);
 
-  // InvalidArgument naming the bad field, AlreadyExists for a taken name.
-  // `default_shards` fills in info.shards when it is 0.
-  absl::StatusOr<MapInfo> Create(MapInfo info, uint32_t default_shards);
+  // InvalidArgument naming the bad field, AlreadyExists for a taken name. `default_shards` fills in info.shards when it
+  // is 0. Ids for which `id_in_use` is true are skipped (the Store passes "a directory by that id exists": never hand
+  // out the id of files the catalog lost track of).
+  absl::StatusOr<MapInfo> Create(MapInfo info, uint32_t default_shards,
+                                 const std::function<bool(uint64_t)>& id_in_use = nullptr);
   // NotFound when no map has that name.
   absl::StatusOr<MapInfo> Get(const std::string& name) const;
   // Maps in name order. page_size 0 = the default (100); at most 1000. The token is opaque.

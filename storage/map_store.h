@@ -61,6 +61,10 @@ struct StoreOptions {
   // Observations after which a state's float spectrum is folded in double (model/wide_bodies.h).
   // Default: model::kCompactRecordLimit; tests lower it.
   uint32_t widen_records_at = model::kCompactRecordLimit;
+  // Before a map is opened, walk its shards' LMDB files in a child process (storage/lmdb/lmdb_probe.h):
+  // LMDB aborts the process on some damaged pages, and a damaged map must fail alone, naming its
+  // file, not take the daemon down. Costs one read of the files at open. Default: true.
+  bool probe_before_open = true;
 };
 
 struct MapStats {

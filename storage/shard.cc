@@ -492,18 +492,27 @@ absl::Status Shard::Load() {
     auto meta_db = txn.Db(kMetaDb);
     if (absl::IsNotFound(meta_db.status())) return absl::OkStatus();  // a new shard
     if (!meta_db.ok()) return meta_db.status();
+    // An absent meta record is a shard never checkpointed; a damaged one (DataLoss) is an error.
     if (auto lsn = txn.Get(*meta_db, Bytes(kLsnKey)); lsn.ok()) {
       if (lsn->size() != 8) return absl::DataLossError("shard meta: checkpoint_lsn is not 8 bytes");
       std::memcpy(&checkpoint_lsn_, lsn->data(), 8);
+    } else if (!absl::IsNotFound(lsn.status())) {
+      return lsn.status();
     }
     if (auto dedup = txn.Get(*meta_db, Bytes(kDedupKey)); dedup.ok()) {
       auto table = DedupTable::Decode(View(*dedup));
       if (!table.ok()) return table.status();
       checkpoint_dedup_ = *std::move(table);
+    } else if (!absl::IsNotFound(dedup.status())) {
+      return dedup.status();
     }
     // Read now, applied once the dynamic states are loaded (a store without it: all touched).
     std::optional<std::string> touched;
-    if (auto t = txn.Get(*meta_db, Bytes(kTouchedKey)); t.ok()) touched = std::string(View(*t));
+    if (auto t = txn.Get(*meta_db, Bytes(kTouchedKey)); t.ok()) {
+      touched = std::string(View(*t));
+    } else if (!absl::IsNotFound(t.status())) {
+      return t.status();
+    }
     absl::Status failure;
     const auto scan = [&](const char* family, const std::function<absl::Status(uint64_t, std::string_view)>& f) {
       auto db = txn.Db(family);

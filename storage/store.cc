@@ -2,22 +2,40 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <filesystem>
-#include <set>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "storage/lmdb/lmdb_probe.h"
 
 namespace fremen::storage {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// The error calls on a failed map get: the open's, naming the map. Never NotFound: the catalog knows the map, its data
+// is what is missing.
+absl::Status Failed(const std::string& name, const absl::Status& open_error) {
+  const absl::StatusCode code = absl::IsNotFound(open_error) ? absl::StatusCode::kDataLoss : open_error.code();
+  return absl::Status(code, absl::StrCat("map \"", name, "\" is failed (it did not open): ", open_error.message()));
+}
+
+}  // namespace
+
 absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& data_dir, const StoreOptions& options) {
   std::error_code error;
   fs::create_directories(data_dir + "/maps", error);
   if (error) return absl::InternalError(absl::StrCat("cannot create ", data_dir, "/maps: ", error.message()));
+  if (options.probe_before_open) {
+    // Without its catalog no map can be served: a damaged catalog file fails the open, but as an error naming the file
+    // rather than an abort inside LMDB.
+    if (absl::Status probed = ProbeEnvironments({data_dir + "/catalog"}); absl::IsDataLoss(probed)) return probed;
+  }
   auto catalog = Catalog::Open(data_dir + "/catalog");
   if (!catalog.ok()) return catalog.status();
   StoreOptions resolved = options;
@@ -25,31 +43,75 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& data_dir, 
   auto store = std::unique_ptr<Store>(new Store(data_dir, resolved, *std::move(catalog)));
 
   std::vector<MapInfo> all;
-  std::string token;
-  do {
-    auto page = store->catalog_->List(kMaxPageSize, token);
-    if (!page.ok()) return page.status();
-    for (MapInfo& m : page->maps) all.push_back(std::move(m));
-    token = page->next_page_token;
-  } while (!token.empty());
-  std::set<std::string> known;
+  std::vector<DamagedCatalogEntry> damaged;
+  if (absl::Status listed = store->ListCatalog(all, damaged); !listed.ok()) return listed;
+  std::lock_guard lock(store->mutex_);
   for (const MapInfo& info : all) {
-    known.insert(std::to_string(info.id));
-    auto map = store->OpenMap(info);
-    if (!map.ok()) return map.status();
+    if (auto map = store->OpenMap(info); !map.ok()) {
+      store->failed_[info.name] =
+          FailedMap{info.name, info.id, store->MapDir(info.id), Failed(info.name, map.status())};
+    }
   }
-  for (const auto& entry : fs::directory_iterator(data_dir + "/maps", error)) {
-    if (!known.contains(entry.path().filename().string())) fs::remove_all(entry.path(), error);
+  for (DamagedCatalogEntry& entry : damaged) {
+    store->failed_[entry.key] = FailedMap{entry.key, 0, "", Failed(entry.key, entry.status)};
   }
+  store->FindUnknownDirectories(all);
   return store;
 }
+
+absl::Status Store::ListCatalog(std::vector<MapInfo>& maps, std::vector<DamagedCatalogEntry>& damaged) const {
+  std::string token;
+  do {
+    auto page = catalog_->List(kMaxPageSize, token);
+    if (!page.ok()) return page.status();
+    for (MapInfo& m : page->maps) maps.push_back(std::move(m));
+    for (DamagedCatalogEntry& d : page->damaged) damaged.push_back(std::move(d));
+    token = page->next_page_token;
+  } while (!token.empty());
+  return absl::OkStatus();
+}
+
+void Store::FindUnknownDirectories(const std::vector<MapInfo>& maps) {
+  std::set<std::string> known;
+  for (const MapInfo& info : maps) known.insert(std::to_string(info.id));
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(data_dir_ + "/maps", error)) {
+    if (!known.contains(entry.path().filename().string())) unknown_dirs_.push_back(entry.path().string());
+  }
+  std::sort(unknown_dirs_.begin(), unknown_dirs_.end());
+}
+
+std::vector<FailedMap> Store::FailedMaps() const {
+  std::lock_guard lock(mutex_);
+  std::vector<FailedMap> failed;
+  for (const auto& [name, map] : failed_) failed.push_back(map);
+  std::sort(failed.begin(), failed.end(), [](const FailedMap& a, const FailedMap& b) { return a.name < b.name; });
+  return failed;
+}
+
+std::vector<std::string> Store::UnknownDirectories() const { return unknown_dirs_; }
 
 Store::~Store() { (void)Close(); }
 
 std::string Store::MapDir(uint64_t id) const { return absl::StrCat(data_dir_, "/maps/", id); }
 
+bool Store::HasDirectory(uint64_t id) const {
+  std::error_code error;
+  return fs::exists(MapDir(id), error) || error;  // in doubt, the id is taken
+}
+
 absl::StatusOr<std::shared_ptr<MapStore>> Store::OpenMap(const MapInfo& info) {
-  auto map = MapStore::Open(info, MapDir(info.id), options_);
+  const std::string dir = MapDir(info.id);
+  if (options_.probe_before_open) {
+    std::vector<std::string> shard_dirs;
+    for (uint32_t i = 0; i < info.shards; ++i) shard_dirs.push_back(absl::StrCat(dir, "/shard-", i));
+    // Unavailable (no child could be forked) tells nothing about the files: they are opened as they were before there
+    // was a probe.
+    if (absl::Status probed = ProbeEnvironments(shard_dirs); absl::IsDataLoss(probed)) {
+      return absl::DataLossError(absl::StrCat("map ", info.name, ": ", probed.message()));
+    }
+  }
+  auto map = MapStore::Open(info, dir, options_);
   if (!map.ok()) return map.status();
   std::shared_ptr<MapStore> shared = *std::move(map);
   maps_[info.name] = shared;
@@ -58,10 +120,14 @@ absl::StatusOr<std::shared_ptr<MapStore>> Store::OpenMap(const MapInfo& info) {
 
 absl::StatusOr<MapInfo> Store::CreateMap(MapInfo info) {
   std::lock_guard lock(mutex_);
-  auto created = catalog_->Create(std::move(info), options_.default_shards);
+  auto created =
+      catalog_->Create(std::move(info), options_.default_shards, [this](uint64_t id) { return HasDirectory(id); });
   if (!created.ok()) return created.status();
   if (auto map = OpenMap(*created); !map.ok()) {
     (void)catalog_->Delete(created->name);
+    std::error_code error;
+    fs::remove_all(MapDir(created->id),
+                   error);  // made by this call: the id had no directory
     return map.status();
   }
   return created;
@@ -75,9 +141,9 @@ absl::StatusOr<MapPage> Store::ListMaps(size_t page_size, const std::string& pag
 
 absl::StatusOr<std::shared_ptr<MapStore>> Store::Map(const std::string& name) const {
   std::lock_guard lock(mutex_);
-  auto it = maps_.find(name);
-  if (it == maps_.end()) return absl::NotFoundError(absl::StrCat("no map named \"", name, "\""));
-  return it->second;
+  if (auto it = maps_.find(name); it != maps_.end()) return it->second;
+  if (auto it = failed_.find(name); it != failed_.end()) return it->second.status;
+  return absl::NotFoundError(absl::StrCat("no map named \"", name, "\""));
 }
 
 absl::Status Store::DeleteMap(const std::string& name) {
@@ -89,6 +155,7 @@ absl::Status Store::DeleteMap(const std::string& name) {
     (void)it->second->Close();
     maps_.erase(it);
   }
+  failed_.erase(name);
   std::error_code error;
   fs::remove_all(MapDir(info->id), error);
   if (error) return absl::InternalError(absl::StrCat("map deleted, but its files remain: ", error.message()));
@@ -115,8 +182,10 @@ absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::str
   MapInfo info = *backed_up;
   if (!name.empty()) info.name = name;
   std::lock_guard lock(mutex_);
-  auto created = catalog_->Create(info, info.shards);
+  auto created = catalog_->Create(info, info.shards, [this](uint64_t id) { return HasDirectory(id); });
   if (!created.ok()) return created.status();
+  // The id has no directory (Create skipped those that do): everything under `target` is this call's, and only that is
+  // removed when the restore fails.
   const std::string target = MapDir(created->id);
   std::error_code error;
   fs::create_directories(target, error);
@@ -127,12 +196,14 @@ absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::str
   }
   if (error) {
     (void)catalog_->Delete(created->name);
-    fs::remove_all(target);
+    std::error_code ignored;
+    fs::remove_all(target, ignored);
     return absl::InternalError(absl::StrCat("restore from ", dir, ": ", error.message()));
   }
   if (auto map = OpenMap(*created); !map.ok()) {
     (void)catalog_->Delete(created->name);
-    fs::remove_all(target);
+    std::error_code ignored;
+    fs::remove_all(target, ignored);
     return map.status();
   }
   return created;

@@ -1,14 +1,26 @@
 // The store: a data directory holding the catalog and every map's files, with every map open.
 //
-// Layout: <data dir>/catalog (LMDB), <data dir>/maps/<id>/{shard-N (LMDB), wal/}. Open() recovers
-// every map (shards from their checkpoints, then their logs) and removes the directories of maps
-// the catalog no longer knows (a crash between a delete's catalog commit and its file removal).
+// Layout: <data dir>/catalog (LMDB), <data dir>/maps/<id>/{shard-N (LMDB), wal/}. Open() recovers every map (shards
+// from their checkpoints, then their logs).
+//
+// Damage is reported, never repaired by deleting:
+// - A map that does not open (a damaged record, a damaged LMDB file found by the probe, a log that does not replay) is
+//   kept as *failed* with its reason (FailedMaps()); the other maps serve. It is still in the catalog, so GetMap and
+//   ListMaps show it; Map() and every call on its data answer its error (DataLoss naming the file, or the open's own
+//   error), never NotFound.
+// - A damaged catalog record is a failed map named by its stored key (GetMap answers DataLoss; ListMaps leaves it out).
+// - A directory under maps/ that no catalog record names (a catalog record lost to damage, or a crash between a
+//   delete's catalog commit and its file removal) is left where it is and listed in UnknownDirectories() for an
+//   operator; no new map is given its id. Only DeleteMap removes a map's files, and only those of the map the catalog
+//   names; CreateMap and RestoreMap, when they fail, remove only the directory they created.
+//
 // Thread-safety: every method may be called from any thread.
 #pragma once
 
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
@@ -17,24 +29,40 @@
 
 namespace fremen::storage {
 
+// A map of the catalog that is not served, and why.
+struct FailedMap {
+  std::string name;
+  uint64_t id = 0;      // 0 when the catalog record itself is damaged
+  std::string dir;      // the map's directory; empty when the id is unknown
+  absl::Status status;  // what Map() answers: the open's error, naming the map (and file)
+};
+
 class Store {
  public:
+  // Fails only when the data directory or the catalog cannot be opened; maps that do not open are failed
+  // (FailedMaps()).
   static absl::StatusOr<std::unique_ptr<Store>> Open(const std::string& data_dir, const StoreOptions& options);
   ~Store();
 
   absl::StatusOr<MapInfo> CreateMap(MapInfo info);
   absl::StatusOr<MapInfo> GetMap(const std::string& name) const;
   absl::StatusOr<MapPage> ListMaps(size_t page_size, const std::string& page_token) const;
-  // Removes the map and all its files.
+  // Removes the map and all its files (a failed map too).
   absl::Status DeleteMap(const std::string& name);
-  // The open map; NotFound when there is none by that name.
+  // The open map; NotFound when there is none by that name, the map's error when it is failed.
   absl::StatusOr<std::shared_ptr<MapStore>> Map(const std::string& name) const;
 
   // A consistent copy of a map to `dir`, while it keeps serving.
   // Returns the bytes written.
   absl::StatusOr<uint64_t> BackupMap(const std::string& name, const std::string& dir);
-  // A backup made by BackupMap as a new map named `name` (empty: the backed-up map's name).
+  // A backup made by BackupMap as a new map named `name` (empty: the backed-up map's name). The copy is probed and
+  // loaded (every record checked) before the map is listed.
   absl::StatusOr<MapInfo> RestoreMap(const std::string& dir, const std::string& name);
+
+  // Maps that did not open at Open, in name order.
+  std::vector<FailedMap> FailedMaps() const;
+  // Directories under <data dir>/maps that no catalog record names (full paths, sorted).
+  std::vector<std::string> UnknownDirectories() const;
 
   // Stops every map (finishing queued writes and checkpointing).
   absl::Status Close();
@@ -43,13 +71,21 @@ class Store {
   Store(std::string data_dir, StoreOptions options, std::unique_ptr<Catalog> catalog)
       : data_dir_(std::move(data_dir)), options_(options), catalog_(std::move(catalog)) {}
   std::string MapDir(uint64_t id) const;
+  // Whether maps/<id> exists: such an id is never given to a new map.
+  bool HasDirectory(uint64_t id) const;
+  // Probes (when enabled) and opens the map's files; on success the map is served.
   absl::StatusOr<std::shared_ptr<MapStore>> OpenMap(const MapInfo& info);
+  // Every catalog record, good ones in `maps` and damaged ones in `damaged`.
+  absl::Status ListCatalog(std::vector<MapInfo>& maps, std::vector<DamagedCatalogEntry>& damaged) const;
+  void FindUnknownDirectories(const std::vector<MapInfo>& maps);
 
   const std::string data_dir_;
   const StoreOptions options_;
   std::unique_ptr<Catalog> catalog_;
-  mutable std::mutex mutex_;  // guards maps_ and serialises create/delete/restore
+  mutable std::mutex mutex_;  // guards maps_, failed_ and serialises create/delete/restore
   absl::flat_hash_map<std::string, std::shared_ptr<MapStore>> maps_;
+  absl::flat_hash_map<std::string, FailedMap> failed_;
+  std::vector<std::string> unknown_dirs_;  // found at Open; read-only after
 };
 
 }  // namespace fremen::storage

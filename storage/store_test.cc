@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "storage/testing/file_damage.h"
 #include "storage/testing/scans.h"
 #include "storage/testing/temp_dir.h"
 
@@ -47,12 +48,24 @@ TEST(StoreTest, MapsLiveAcrossRestartsAndDeleteRemovesTheirFiles) {
   EXPECT_TRUE(absl::IsNotFound((*store)->DeleteMap("a")));
 }
 
-TEST(StoreTest, OrphanMapDirectoriesAreRemovedAtOpen) {
+// A directory the catalog does not name (a lost catalog record, an interrupted delete) is never
+// removed: it is reported, and its id is never given to a new map.
+TEST(StoreTest, DirectoriesTheCatalogDoesNotNameAreReportedAndKept) {
   TempDir dir;
   { ASSERT_TRUE(Store::Open(dir.path(), {}).ok()); }
   std::filesystem::create_directories(dir.path() + "/maps/999/shard-0");
-  ASSERT_TRUE(Store::Open(dir.path(), {}).ok());
-  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/maps/999"));
+  std::filesystem::create_directories(dir.path() + "/maps/1/shard-0");  // the id the next map would get
+  testing::WriteWholeFile(dir.path() + "/maps/1/shard-0/data.mdb", "someone's data");
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok()) << store.status();
+  EXPECT_EQ((*store)->UnknownDirectories(),
+            (std::vector<std::string>{dir.path() + "/maps/1", dir.path() + "/maps/999"}));
+  auto created = (*store)->CreateMap(GridMap("new", 8, 8, 1, 1));
+  ASSERT_TRUE(created.ok()) << created.status();
+  EXPECT_EQ(created->id, 2u);
+  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/maps/1/shard-0/data.mdb"), "someone's data");
+  EXPECT_TRUE(std::filesystem::exists(dir.path() + "/maps/999/shard-0"));
+  EXPECT_TRUE((*store)->FailedMaps().empty());
 }
 
 TEST(StoreTest, BackupUnderLoadRestoresAConsistentMap) {

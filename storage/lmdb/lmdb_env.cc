@@ -4,9 +4,25 @@
 
 #include <cstring>
 
+#include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
+#include "storage/lmdb/record_checksum.h"
 
 namespace fremen::storage {
+
+namespace {
+
+// The internal database holding the record format marker (lmdb_env.h).
+constexpr char kFormatDb[] = "fremen";
+constexpr char kFormatKey[] = "record_format";
+
+std::span<const uint8_t> Bytes(std::string_view s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
+
+std::string Hex(std::span<const uint8_t> bytes) {
+  return absl::BytesToHexString(absl::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+}
+
+}  // namespace
 
 absl::Status LmdbStatus(int rc, absl::string_view what) {
   if (rc == MDB_SUCCESS) return absl::OkStatus();
@@ -50,26 +66,71 @@ absl::Status LmdbEnv::OpenDatabases(const std::vector<std::string>& names) {
     rc = mdb_dbi_open(txn, name.c_str(), MDB_CREATE, &dbi);
     if (rc != MDB_SUCCESS) {
       mdb_txn_abort(txn);
-      return LmdbStatus(rc, absl::StrCat("mdb_dbi_open ", name));
+      return LmdbStatus(rc, absl::StrCat("mdb_dbi_open ", name, " in ", file_));
     }
     dbs_[name] = dbi;
+  }
+  LmdbTxn wrapped(txn, &dbs_, &file_);
+  if (absl::Status format = CheckRecordFormat(wrapped); !format.ok()) {
+    mdb_txn_abort(txn);
+    return format;
   }
   return LmdbStatus(mdb_txn_commit(txn), "mdb_txn_commit (databases)");
 }
 
-absl::Status LmdbTxn::Put(MDB_dbi dbi, std::span<const uint8_t> key, std::span<const uint8_t> value,
-                          unsigned flags) {
-  MDB_val k = AsVal(key), v = AsVal(value);
-  const int rc = mdb_put(txn_, dbi, &k, &v, flags);
+absl::Status LmdbEnv::CheckRecordFormat(LmdbTxn& txn) {
+  MDB_dbi format_db;
+  if (int rc = mdb_dbi_open(txn.get(), kFormatDb, MDB_CREATE, &format_db); rc != MDB_SUCCESS) {
+    return LmdbStatus(rc, absl::StrCat("mdb_dbi_open ", kFormatDb, " in ", file_));
+  }
+  auto marker = txn.Get(format_db, Bytes(kFormatKey));
+  if (marker.ok()) {
+    if (marker->size() == 1 && (*marker)[0] == kLmdbRecordFormat) return absl::OkStatus();
+    return absl::FailedPreconditionError(absl::StrCat(file_, " holds records of format ",
+                                                      marker->size() == 1 ? (*marker)[0] : -1,
+                                                      "; this build reads format ", kLmdbRecordFormat));
+  }
+  if (!absl::IsNotFound(marker.status())) return marker.status();
+  // No marker: a new environment, or one written before records had checksums.
+  for (const auto& [name, dbi] : dbs_) {
+    auto count = txn.Count(dbi);
+    if (!count.ok()) return count.status();
+    if (*count > 0) {
+      return absl::FailedPreconditionError(absl::StrCat(file_, " holds records without checksums (database ", name,
+                                                        ", written by a fremen before record format ",
+                                                        kLmdbRecordFormat, "); this build cannot read them"));
+    }
+  }
+  const uint8_t format = kLmdbRecordFormat;
+  return txn.Put(format_db, Bytes(kFormatKey), {&format, 1});
+}
+
+absl::Status LmdbTxn::Put(MDB_dbi dbi, std::span<const uint8_t> key, std::span<const uint8_t> value, unsigned flags) {
+  // MDB_RESERVE: LMDB makes room and the value and its checksum are written there, with no copy.
+  MDB_val k = AsVal(key), v{value.size() + kRecordChecksumBytes, nullptr};
+  const int rc = mdb_put(txn_, dbi, &k, &v, flags | MDB_RESERVE);
   if (rc == MDB_MAP_FULL) map_full_ = true;
+  if (rc == MDB_SUCCESS) EncodeChecked(key, value, static_cast<uint8_t*>(v.mv_data));
   return LmdbStatus(rc, "mdb_put");
+}
+
+absl::StatusOr<std::span<const uint8_t>> LmdbTxn::Checked(MDB_dbi dbi, std::span<const uint8_t> key,
+                                                          std::span<const uint8_t> stored) const {
+  auto value = CheckRecord(key, stored);
+  if (value.ok()) return value;
+  std::string db = "?";
+  for (const auto& [name, handle] : *dbs_) {
+    if (handle == dbi) db = name;
+  }
+  return absl::DataLossError(
+      absl::StrCat(*file_, ": database ", db, ", key ", Hex(key), ": ", value.status().message()));
 }
 
 absl::StatusOr<std::span<const uint8_t>> LmdbTxn::Get(MDB_dbi dbi, std::span<const uint8_t> key) const {
   MDB_val k = AsVal(key), v;
   const int rc = mdb_get(txn_, dbi, &k, &v);
-  if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_get");
-  return AsBytes(v);
+  if (rc != MDB_SUCCESS) return LmdbStatus(rc, absl::StrCat("mdb_get ", *file_));
+  return Checked(dbi, key, AsBytes(v));
 }
 
 absl::Status LmdbTxn::Delete(MDB_dbi dbi, std::span<const uint8_t> key) {
@@ -82,6 +143,20 @@ absl::Status LmdbTxn::Drop(MDB_dbi dbi) { return LmdbStatus(mdb_drop(txn_, dbi, 
 
 absl::Status LmdbTxn::Scan(MDB_dbi dbi, std::span<const uint8_t> begin, std::span<const uint8_t> end,
                            const std::function<bool(std::span<const uint8_t>, std::span<const uint8_t>)>& f) const {
+  absl::Status damaged;
+  const absl::Status scanned = ScanChecked(dbi, begin, end, [&](auto key, auto value) {
+    if (!value.ok()) {
+      damaged = value.status();
+      return false;
+    }
+    return f(key, *value);
+  });
+  return scanned.ok() ? damaged : scanned;
+}
+
+absl::Status LmdbTxn::ScanChecked(
+    MDB_dbi dbi, std::span<const uint8_t> begin, std::span<const uint8_t> end,
+    const std::function<bool(std::span<const uint8_t>, absl::StatusOr<std::span<const uint8_t>>)>& f) const {
   MDB_cursor* cursor;
   int rc = mdb_cursor_open(txn_, dbi, &cursor);
   if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_cursor_open");
@@ -93,11 +168,12 @@ absl::Status LmdbTxn::Scan(MDB_dbi dbi, std::span<const uint8_t> begin, std::spa
       const int cmp = std::memcmp(key.data(), end.data(), std::min(key.size(), end.size()));
       if (cmp > 0 || (cmp == 0 && key.size() >= end.size())) break;
     }
-    if (!f(key, AsBytes(v))) break;
+    if (!f(key, Checked(dbi, key, AsBytes(v)))) break;
     rc = mdb_cursor_get(cursor, &k, &v, MDB_NEXT);
   }
   mdb_cursor_close(cursor);
-  return rc == MDB_SUCCESS || rc == MDB_NOTFOUND ? absl::OkStatus() : LmdbStatus(rc, "mdb_cursor_get");
+  return rc == MDB_SUCCESS || rc == MDB_NOTFOUND ? absl::OkStatus()
+                                                 : LmdbStatus(rc, absl::StrCat("mdb_cursor_get ", *file_));
 }
 
 absl::StatusOr<size_t> LmdbTxn::Count(MDB_dbi dbi) const {
@@ -165,7 +241,7 @@ absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {
       std::shared_lock lock(resize_);
       rc = mdb_txn_begin(env_, nullptr, 0, &txn);
       if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin");
-      LmdbTxn wrapped(txn, &dbs_);
+      LmdbTxn wrapped(txn, &dbs_, &file_);
       absl::Status status = f(wrapped);
       if (!status.ok()) {
         mdb_txn_abort(txn);
@@ -191,7 +267,7 @@ absl::Status LmdbEnv::Read(const std::function<absl::Status(LmdbTxn&)>& f) const
   MDB_txn* txn;
   const int rc = mdb_txn_begin(env_, nullptr, MDB_RDONLY, &txn);
   if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin (read)");
-  LmdbTxn wrapped(txn, &dbs_);
+  LmdbTxn wrapped(txn, &dbs_, &file_);
   absl::Status status = f(wrapped);
   mdb_txn_abort(txn);
   return status;

@@ -1,17 +1,24 @@
 // A thin, safe wrapper over one LMDB environment (one directory, one data file).
 //
 // What it adds to LMDB (see lmdb.h):
-// - every return code becomes an absl::Status in one place (LmdbStatus), MDB_CORRUPTED and
-//   MDB_PAGE_NOTFOUND as DataLoss, MDB_MAP_FULL as ResourceExhausted;
-// - write transactions that hit MDB_MAP_FULL are aborted, the map is grown (doubled, while no
-//   transaction of this process is active) and the transaction is run again — so callers write a
-//   function that can be retried, never a half-applied one;
+// - every return code becomes an absl::Status in one place (LmdbStatus), MDB_CORRUPTED and MDB_PAGE_NOTFOUND as
+//   DataLoss, MDB_MAP_FULL as ResourceExhausted;
+// - write transactions that hit MDB_MAP_FULL are aborted, the map is grown (doubled, while no transaction of this
+//   process is active) and the transaction is run again — so callers write a function that can be retried, never a
+//   half-applied one;
 // - stale reader slots of dead processes are cleared at open and on demand (mdb_reader_check);
-// - a failed commit/sync latches the environment: every later write fails with the first error
-//   (the leveldb bg_error_ pattern) instead of pretending data is durable.
+// - a failed commit/sync latches the environment: every later write fails with the first error (the leveldb bg_error_
+//   pattern) instead of pretending data is durable;
+// - every record carries a checksum of its key and value (record_checksum.h): Put appends it, Get and Scan check it and
+//   hand back the value without it; a mismatch is DataLoss naming the file (<dir>/data.mdb), the database and the key
+//   (hex). Nothing reads or writes values past this.
 //
-// Thread-safety: one writer at a time (Write serialises writers); any number of concurrent readers
-// (Read). Read transactions are short: they hold a shared lock that map growth waits for.
+// Record format: an environment records the format of its records (internal database "fremen", key "record_format").
+// Format 1: value + checksum trailer. Files written before checksums (format 0, no marker but records) are refused at
+// Open (FailedPrecondition) rather than read as damaged.
+//
+// Thread-safety: one writer at a time (Write serialises writers); any number of concurrent readers (Read). Read
+// transactions are short: they hold a shared lock that map growth waits for.
 #pragma once
 
 #include <lmdb.h>
@@ -28,7 +35,6 @@
 #include <vector>
 
 #include "absl/container/flat_hash_map.h"
-
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -58,37 +64,52 @@ struct LmdbOptions {
 inline std::span<const uint8_t> AsBytes(const MDB_val& v) {
   return {static_cast<const uint8_t*>(v.mv_data), v.mv_size};
 }
-inline MDB_val AsVal(std::span<const uint8_t> bytes) {
-  return {bytes.size(), const_cast<uint8_t*>(bytes.data())};
-}
+inline MDB_val AsVal(std::span<const uint8_t> bytes) { return {bytes.size(), const_cast<uint8_t*>(bytes.data())}; }
 
 using DbHandles = absl::flat_hash_map<std::string, MDB_dbi>;
 
+// The record format this build writes and reads (see above).
+inline constexpr uint8_t kLmdbRecordFormat = 1;
+
 class LmdbTxn {
  public:
-  LmdbTxn(MDB_txn* txn, const DbHandles* dbs) : txn_(txn), dbs_(dbs) {}
+  // `file` names the environment's data file in errors.
+  LmdbTxn(MDB_txn* txn, const DbHandles* dbs, const std::string* file) : txn_(txn), dbs_(dbs), file_(file) {}
   MDB_txn* get() const { return txn_; }
 
   // A database declared in LmdbOptions::databases; InvalidArgument for an undeclared name.
   absl::StatusOr<MDB_dbi> Db(const std::string& name) const;
+  // Stores value with its checksum. `flags` as mdb_put's (MDB_NOOVERWRITE); MDB_RESERVE is implied.
   absl::Status Put(MDB_dbi dbi, std::span<const uint8_t> key, std::span<const uint8_t> value, unsigned flags = 0);
-  // NotFound when absent; the view is valid until the transaction ends.
+  // NotFound when absent, DataLoss when the checksum does not match; the view (without the checksum) is valid until the
+  // transaction ends.
   absl::StatusOr<std::span<const uint8_t>> Get(MDB_dbi dbi, std::span<const uint8_t> key) const;
   // OK whether or not the key existed.
   absl::Status Delete(MDB_dbi dbi, std::span<const uint8_t> key);
   absl::Status Drop(MDB_dbi dbi);
-  // Calls f(key, value) for keys in [begin, end) in key order (end empty: to the last key) until f
-  // returns false.
+  // Calls f(key, value) for keys in [begin, end) in key order (end empty: to the last key) until f returns false. A
+  // record whose checksum does not match ends the scan with DataLoss.
   absl::Status Scan(MDB_dbi dbi, std::span<const uint8_t> begin, std::span<const uint8_t> end,
                     const std::function<bool(std::span<const uint8_t>, std::span<const uint8_t>)>& f) const;
+  // As Scan, but a damaged record is handed to f as its DataLoss (naming file, database and key) and the scan goes on:
+  // for callers that report damaged records and keep the others.
+  absl::Status ScanChecked(
+      MDB_dbi dbi, std::span<const uint8_t> begin, std::span<const uint8_t> end,
+      const std::function<bool(std::span<const uint8_t>, absl::StatusOr<std::span<const uint8_t>>)>& f) const;
+  // Records in the database (no value is read, so none is checked).
   absl::StatusOr<size_t> Count(MDB_dbi dbi) const;
 
   // Whether a put ran out of map space (LmdbEnv::Write then grows the map and retries).
   bool map_full() const { return map_full_; }
 
  private:
+  // The value of a stored record, or DataLoss naming file, database and key.
+  absl::StatusOr<std::span<const uint8_t>> Checked(MDB_dbi dbi, std::span<const uint8_t> key,
+                                                   std::span<const uint8_t> stored) const;
+
   MDB_txn* txn_;
   const DbHandles* dbs_;
+  const std::string* file_;
   bool map_full_ = false;
 };
 
@@ -117,20 +138,26 @@ class LmdbEnv {
   // Bytes of the data file in use (pages up to the last one written).
   absl::StatusOr<size_t> UsedBytes() const;
   const std::string& dir() const { return dir_; }
+  // <dir>/data.mdb, as errors name it.
+  const std::string& file() const { return file_; }
   // The latched error of a failed commit or sync, OK when healthy.
   absl::Status health() const;
 
  private:
-  LmdbEnv(MDB_env* env, std::string dir, size_t map_size) : env_(env), dir_(std::move(dir)), map_size_(map_size) {}
+  LmdbEnv(MDB_env* env, std::string dir, size_t map_size)
+      : env_(env), dir_(std::move(dir)), file_(dir_ + "/data.mdb"), map_size_(map_size) {}
   absl::Status Grow();
   absl::Status OpenDatabases(const std::vector<std::string>& names);
+  // Writes the record format marker into a new environment; refuses one of another format.
+  absl::Status CheckRecordFormat(LmdbTxn& txn);
   void Latch(const absl::Status& status);
 
   MDB_env* env_;
   std::string dir_;
+  std::string file_;
   size_t map_size_;
-  std::mutex writer_;                    // one write transaction at a time
-  mutable std::shared_mutex resize_;     // readers shared, map growth exclusive
+  std::mutex writer_;                 // one write transaction at a time
+  mutable std::shared_mutex resize_;  // readers shared, map growth exclusive
   mutable std::mutex latch_mutex_;
   absl::Status latched_;
   DbHandles dbs_;  // written once, at Open

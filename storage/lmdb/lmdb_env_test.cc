@@ -6,6 +6,8 @@
 #include <thread>
 #include <vector>
 
+#include "absl/strings/escaping.h"
+#include "storage/testing/file_damage.h"
 #include "storage/testing/temp_dir.h"
 
 namespace fremen::storage {
@@ -161,6 +163,145 @@ TEST(LmdbEnvTest, OpeningAGarbageFileIsAnErrorNotACrash) {
   }
   auto env = LmdbEnv::Open(dir.path(), Cells());
   EXPECT_FALSE(env.ok());
+}
+
+
+// One record under a distinctive key and value, in a closed environment at `dir`.
+void WriteOneRecord(const std::string& dir, const std::vector<uint8_t>& key, const std::vector<uint8_t>& value) {
+  auto env = LmdbEnv::Open(dir, Cells());
+  ASSERT_TRUE(env.ok()) << env.status();
+  ASSERT_TRUE((*env)->Write([&](LmdbTxn& txn) -> absl::Status { return txn.Put(*txn.Db("cells"), key, value); }).ok());
+}
+
+TEST(LmdbEnvTest, ValuesComeBackWithoutTheirChecksum) {
+  testing::TempDir dir;
+  auto env = LmdbEnv::Open(dir.path(), Cells());
+  ASSERT_TRUE(env.ok());
+  const std::vector<uint8_t> value = {1, 2, 3, 4, 5}, empty;
+  ASSERT_TRUE((*env)->Write([&](LmdbTxn& txn) -> absl::Status {
+    if (auto s = txn.Put(*txn.Db("cells"), Key(1), value); !s.ok()) return s;
+    return txn.Put(*txn.Db("cells"), Key(2), empty);
+  }).ok());
+  // MDB_NOOVERWRITE keeps its meaning (the catalog's unique names).
+  EXPECT_TRUE(absl::IsAlreadyExists((*env)->Write([&](LmdbTxn& txn) {
+    return txn.Put(*txn.Db("cells"), Key(1), empty, MDB_NOOVERWRITE);
+  })));
+  ASSERT_TRUE((*env)->Read([&](LmdbTxn& txn) -> absl::Status {
+    auto one = txn.Get(*txn.Db("cells"), Key(1));
+    EXPECT_TRUE(one.ok()) << one.status();
+    if (one.ok()) {
+      EXPECT_EQ(std::vector<uint8_t>(one->begin(), one->end()), value);
+    }
+    auto two = txn.Get(*txn.Db("cells"), Key(2));
+    EXPECT_TRUE(two.ok() && two->empty());
+    std::vector<size_t> sizes;
+    EXPECT_TRUE(txn.Scan(*txn.Db("cells"), {}, {}, [&](auto, auto v) {
+      sizes.push_back(v.size());
+      return true;
+    }).ok());
+    EXPECT_EQ(sizes, (std::vector<size_t>{5, 0}));
+    return absl::OkStatus();
+  }).ok());
+}
+
+// Every single-bit flip in a record's value or checksum, and in its key, is caught: the read is
+// DataLoss naming the file, the database and the key, never the damaged bytes.
+TEST(LmdbEnvTest, EveryBitFlipInARecordIsDataLossNamingFileDatabaseAndKey) {
+  testing::TempDir dir;
+  const std::vector<uint8_t> key = Key(0x0123456789abcdefull);
+  const std::vector<uint8_t> value = {'s', 'p', 'e', 'c', 't', 'r', 'u', 'm', 0x5a, 0xa5, 0x3c, 0xc3};
+  WriteOneRecord(dir.path(), key, value);
+  const std::string file = dir.path() + "/data.mdb";
+  const std::string pristine = testing::ReadWholeFile(file);
+  const size_t value_at = testing::FindUnique(pristine, value);
+  const size_t key_at = testing::FindUnique(pristine, key);
+  ASSERT_NE(value_at, std::string::npos);
+  ASSERT_NE(key_at, std::string::npos);
+  const std::string hex_key = absl::BytesToHexString(absl::string_view(reinterpret_cast<const char*>(key.data()), 8));
+  // The value and its 4-byte checksum are contiguous; then the key's 8 bytes.
+  std::vector<size_t> offsets;
+  for (size_t i = 0; i < value.size() + 4; ++i) offsets.push_back(value_at + i);
+  for (size_t i = 0; i < key.size(); ++i) offsets.push_back(key_at + i);
+  int flips = 0;
+  for (const size_t offset : offsets) {
+    for (int bit = 0; bit < 8; ++bit) {
+      testing::WriteWholeFile(file, pristine);
+      testing::FlipBit(file, offset, bit);
+      auto env = LmdbEnv::Open(dir.path(), Cells());
+      ASSERT_TRUE(env.ok()) << env.status();
+      const bool in_key = offset >= key_at && offset < key_at + key.size();
+      ASSERT_TRUE((*env)->Read([&](LmdbTxn& txn) -> absl::Status {
+        auto got = txn.Get(*txn.Db("cells"), key);
+        if (in_key) {
+          EXPECT_TRUE(absl::IsNotFound(got.status())) << got.status();  // the record no longer has that key
+        } else {
+          EXPECT_TRUE(absl::IsDataLoss(got.status())) << "byte " << offset << " bit " << bit << ": " << got.status();
+          EXPECT_NE(got.status().message().find(file), std::string::npos) << got.status();
+          EXPECT_NE(got.status().message().find("database cells, key " + hex_key), std::string::npos) << got.status();
+        }
+        const absl::Status scanned = txn.Scan(*txn.Db("cells"), {}, {}, [](auto, auto) { return true; });
+        EXPECT_TRUE(absl::IsDataLoss(scanned)) << "byte " << offset << " bit " << bit << ": " << scanned;
+        EXPECT_NE(scanned.message().find(file), std::string::npos) << scanned;
+        return absl::OkStatus();
+      }).ok());
+      ++flips;
+    }
+  }
+  EXPECT_EQ(flips, 8 * (12 + 4 + 8));
+}
+
+TEST(LmdbEnvTest, ScanCheckedReportsADamagedRecordAndGoesOn) {
+  testing::TempDir dir;
+  const std::vector<uint8_t> damaged_value = {'d', 'a', 'm', 'a', 'g', 'e', 'd', '!'};
+  {
+    auto env = LmdbEnv::Open(dir.path(), Cells());
+    ASSERT_TRUE(env.ok());
+    ASSERT_TRUE((*env)->Write([&](LmdbTxn& txn) -> absl::Status {
+      for (uint64_t i = 0; i < 3; ++i) {
+        if (auto s = txn.Put(*txn.Db("cells"), Key(i), i == 1 ? damaged_value : Key(100 + i)); !s.ok()) return s;
+      }
+      return absl::OkStatus();
+    }).ok());
+  }
+  const std::string file = dir.path() + "/data.mdb";
+  const size_t at = testing::FindUnique(testing::ReadWholeFile(file), damaged_value);
+  ASSERT_NE(at, std::string::npos);
+  testing::FlipBit(file, at + 3, 0);
+  auto env = LmdbEnv::Open(dir.path(), Cells());
+  ASSERT_TRUE(env.ok());
+  std::vector<std::string> seen;
+  ASSERT_TRUE((*env)->Read([&](LmdbTxn& txn) -> absl::Status {
+    return txn.ScanChecked(*txn.Db("cells"), {}, {}, [&](auto, auto value) {
+      seen.push_back(value.ok() ? "ok" : std::string(value.status().message()));
+      return true;
+    });
+  }).ok());
+  ASSERT_EQ(seen.size(), 3u);
+  EXPECT_EQ(seen[0], "ok");
+  EXPECT_NE(seen[1].find("key 0000000000000001: checksum mismatch"), std::string::npos) << seen[1];
+  EXPECT_EQ(seen[2], "ok");
+}
+
+// A file written before records had checksums is refused as such, not read as 100% damage.
+TEST(LmdbEnvTest, RecordsWithoutChecksumsAreRefusedAtOpen) {
+  testing::TempDir dir;
+  MDB_env* raw;
+  ASSERT_EQ(mdb_env_create(&raw), MDB_SUCCESS);
+  mdb_env_set_maxdbs(raw, 4);
+  ASSERT_EQ(mdb_env_open(raw, dir.path().c_str(), 0, 0640), MDB_SUCCESS);
+  MDB_txn* txn;
+  MDB_dbi dbi;
+  ASSERT_EQ(mdb_txn_begin(raw, nullptr, 0, &txn), MDB_SUCCESS);
+  ASSERT_EQ(mdb_dbi_open(txn, "cells", MDB_CREATE, &dbi), MDB_SUCCESS);
+  std::vector<uint8_t> key = Key(1), value = Key(2);
+  MDB_val k = AsVal(key), v = AsVal(value);
+  ASSERT_EQ(mdb_put(txn, dbi, &k, &v, 0), MDB_SUCCESS);
+  ASSERT_EQ(mdb_txn_commit(txn), MDB_SUCCESS);
+  mdb_env_close(raw);
+  auto env = LmdbEnv::Open(dir.path(), Cells());
+  ASSERT_EQ(env.status().code(), absl::StatusCode::kFailedPrecondition) << env.status();
+  EXPECT_NE(env.status().message().find("without checksums"), std::string::npos) << env.status();
+  EXPECT_NE(env.status().message().find(dir.path() + "/data.mdb"), std::string::npos) << env.status();
 }
 
 }  // namespace
