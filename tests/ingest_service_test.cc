@@ -184,12 +184,12 @@ class IngestServiceTest : public DaemonTest {
     EXPECT_TRUE(status.ok()) << status.error_message();
     return response.stats().observations();
   }
-  grpc::Status LastSequence(const std::string& map, uint64_t writer, uint64_t& last) {
+  grpc::Status LastSequence(const std::string& map, uint64_t writer, uint64_t& last, const Metadata& metadata = {}) {
     v1::LastSequenceRequest request;
     request.set_map(map);
     request.set_writer_id(writer);
     v1::LastSequenceResponse response;
-    const grpc::Status status = ingest_->LastSequence(CallContext().get(), request, &response);
+    const grpc::Status status = ingest_->LastSequence(CallContext(metadata).get(), request, &response);
     last = response.last_sequence();
     return status;
   }
@@ -654,7 +654,7 @@ class IngestTokenTest : public IngestServiceTest {
   static Metadata Bearer(const std::string& token) { return {{"authorization", "Bearer " + token}}; }
 };
 
-TEST_F(IngestTokenTest, IngestNeedsAWriteToken) {
+TEST_F(IngestTokenTest, IngestAndLastSequenceNeedAWriteToken) {
   Create(GridMap("lab"), Bearer("writer-token"));
   {
     Stream read_only(*ingest_, Bearer("reader-token"));
@@ -671,6 +671,11 @@ TEST_F(IngestTokenTest, IngestNeedsAWriteToken) {
   Stream writer(*ingest_, Bearer("writer-token"));
   ExpectAck(writer.Call(RowBatch("lab", 1, 1)), 1, 40);
   EXPECT_TRUE(writer.Close().ok());
+  uint64_t last = 0;
+  const grpc::Status read_only = LastSequence("lab", 1, last, Bearer("reader-token"));
+  EXPECT_EQ(read_only.error_code(), grpc::StatusCode::PERMISSION_DENIED) << read_only.error_message();
+  ASSERT_TRUE(LastSequence("lab", 1, last, Bearer("writer-token")).ok());
+  EXPECT_EQ(last, 1u);
 }
 
 // --- kill -9 ---
