@@ -294,10 +294,15 @@ void MapStore::Latch(const absl::Status& status) {
   {
     std::lock_guard lock(queue_mutex_);
     if (!write_error_.ok()) return;
-    write_error_ = absl::Status(status.code(), absl::StrCat("map ", info_.name,
-                                                            " refuses writes after a storage error (acknowledged "
-                                                            "data is kept; restart fremend once it is fixed): ",
-                                                            status.message()));
+    // A full disk stays ResourceExhausted; any other fault (an I/O error) is Unavailable: the map
+    // takes no writes until an operator fixes the cause and reopens it. The message keeps the cause.
+    const bool full = status.code() == absl::StatusCode::kResourceExhausted;
+    write_error_ = absl::Status(
+        full ? status.code() : absl::StatusCode::kUnavailable,
+        absl::StrCat("map ", info_.name,
+                     " refuses writes after a storage error (acknowledged data is kept; "
+                     "restart fremend once it is fixed): ",
+                     full ? "" : absl::StrCat(absl::StatusCodeToString(status.code()), ": "), status.message()));
     room.swap(room_waiters_);
   }
   // Waiters for room would otherwise wait for ever (the queue may stay full of batches that will

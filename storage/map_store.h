@@ -12,8 +12,9 @@
 // every shard from its checkpoint, then the log after it.
 //
 // Storage errors (a failed log sync, commit or checkpoint: a full disk, an I/O error) latch: from
-// then on every write is refused at once with that error (WriteError), and waiters of OnRoom are
-// woken, so that no caller mistakes a failed map for a busy one.
+// then on every write is refused at once with that error (WriteError: ResourceExhausted for a full
+// disk, Unavailable for any other cause, named in the message), and waiters of OnRoom are woken,
+// so that no caller mistakes a failed map for a busy one.
 //
 // Reads run concurrently with writes and see every acknowledged batch.
 // Thread-safety: every public method may be called from any thread.

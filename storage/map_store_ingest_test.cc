@@ -167,5 +167,24 @@ TEST(MapStoreIngestTest, AFullDiskIsNotBackpressureAndWakesTheWaitersForRoom) {
   EXPECT_FALSE(next->duplicate);
 }
 
+TEST(MapStoreIngestTest, AnIoErrorRefusesWritesWithUnavailableNamingTheCause) {
+  TempDir dir;
+  const MapInfo map = GridMap("m", 16, 16, 1, 1);
+  std::atomic<bool> failing = false;
+  StoreOptions options;
+  options.inject_log_fault = [&]() -> absl::Status {
+    return failing ? absl::InternalError("fdatasync of the write-ahead log: Input/output error") : absl::OkStatus();
+  };
+  auto store = OpenOrDie(map, dir.path(), options);
+  ASSERT_TRUE(store->Write(Scan(map, 1)).ok());
+  failing = true;
+  EXPECT_FALSE(store->Write(Scan(map, 2)).ok());
+  const absl::Status refused = store->Submit(Scan(map, 3), [](auto) { FAIL() << "refused: never called"; });
+  EXPECT_TRUE(absl::IsUnavailable(refused)) << refused;
+  EXPECT_NE(refused.message().find("map m refuses writes"), std::string::npos) << refused;
+  EXPECT_NE(refused.message().find("INTERNAL: fdatasync of the write-ahead log: Input/output error"), std::string::npos)
+      << refused;
+}
+
 }  // namespace
 }  // namespace fremen::storage
