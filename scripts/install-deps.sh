@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
-  liblmdb-dev lmdb-utils zlib1g-dev libeigen3-dev libspdlog-dev libfftw3-dev libcli11-dev
+  liblmdb-dev lmdb-utils zlib1g-dev libxxhash-dev libeigen3-dev libspdlog-dev libfftw3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-grpcio python3-protobuf python3-numpy
   openssl  # the tests make their TLS certificates with it

@@ -231,6 +231,7 @@ absl::StatusOr<ObservationBatch> BatchFromRequest(const MapInfo& map, const v1::
 }
 
 void AckToResponse(const storage::BatchAck& ack, v1::IngestResponse& out) {
+  if (!ack.error.ok()) return ErrorToResponse(ack.sequence, ack.error, out);
   out.set_sequence(ack.sequence);
   out.set_accepted(ack.accepted);
   out.set_rejected(ack.rejected);

@@ -31,7 +31,7 @@ inline constexpr uint64_t kOutsideMapKey = ~uint64_t{0};
 absl::StatusOr<storage::ObservationBatch> BatchFromRequest(const storage::MapInfo& map,
                                                            const v1::IngestRequest& request);
 
-// The response acknowledging a batch.
+// The response acknowledging a batch (or refusing it, when the store refused it: ack.error).
 void AckToResponse(const storage::BatchAck& ack, v1::IngestResponse& out);
 
 // The response refusing batch `sequence` as a whole.

@@ -69,7 +69,11 @@ void IngestStream::OnReadDone(bool ok) {
     // From here until the store has it, request_ is the stream's: no read may overwrite it.
     holding_ = true;
   }
-  if (absl::Status routed = Route(); !routed.ok()) {
+  // An unparsable message ends the stream: the batches after it cannot be trusted to be what the
+  // client sent either. Then the map is routed.
+  absl::Status routed = Parse();
+  if (routed.ok()) routed = Route();
+  if (!routed.ok()) {
     std::lock_guard lock(mutex_);
     holding_ = false;
     EndLocked(routed);
@@ -82,6 +86,16 @@ void IngestStream::OnReadDone(bool ok) {
   SubmitHeld();
   std::lock_guard lock(mutex_);
   PumpLocked();
+}
+
+absl::Status IngestStream::Parse() {
+  ++messages_;
+  const grpc::Status parsed = grpc::SerializationTraits<v1::IngestRequest>::Deserialize(&message_, &request_);
+  if (parsed.ok()) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrCat("message ", messages_, " of the stream: cannot parse ",
+                                                 v1::IngestRequest::descriptor()->name(),
+                                                 " (the batches before it are answered; it and the ones after "
+                                                 "are not applied)"));
 }
 
 absl::Status IngestStream::Route() {
@@ -114,7 +128,7 @@ void IngestStream::SubmitHeld() {
   std::unique_lock lock(mutex_);
   if (status.ok()) {
     holding_ = false;
-  } else if (status.code() == absl::StatusCode::kResourceExhausted && !EndingLocked()) {
+  } else if (storage::IsQueueFull(status) && !EndingLocked()) {
     waiting_room_ = true;
     lock.unlock();
     WaitForRoom(observations);
@@ -222,7 +236,12 @@ void IngestStream::PumpLocked() {
   if (finished_) return;
   if (!writing_ && !cancelled_ && !slots_.empty() && slots_.front().ready) {
     writing_ = true;
-    StartWrite(&slots_.front().response);
+    Slot& front = slots_.front();
+    bool own_buffer = false;
+    const grpc::Status serialized =
+        grpc::SerializationTraits<v1::IngestResponse>::Serialize(front.response, &front.bytes, &own_buffer);
+    if (!serialized.ok()) return FinishLocked(absl::InternalError(std::string(serialized.error_message())));
+    StartWrite(&front.bytes);
   }
   if (!writing_) {
     if (cancelled_) return FinishLocked(absl::CancelledError("the client cancelled the stream"));
@@ -231,7 +250,7 @@ void IngestStream::PumpLocked() {
   }
   if (!reading_ && !holding_ && !EndingLocked() && slots_.size() < kMaxUnanswered) {
     reading_ = true;
-    StartRead(&request_);
+    StartRead(&message_);
   }
 }
 

@@ -1,16 +1,21 @@
 // One fremen.v1.IngestService.Ingest call: a bidirectional stream of batches in, one IngestResponse
 // out per batch, in batch order, each once the store says the batch is durable and applied.
 //
-// Flow: OnReadDone converts the request (server/ingest_convert.h) and hands it to
-// MapStore::Submit, whose callback (on a store thread) fills the batch's slot; slots are written
-// in order, one StartWrite at a time.
+// Flow: OnReadDone parses the message (the stream reads raw bytes, so that an unparsable message
+// is told from the client's end of the stream), converts the request (server/ingest_convert.h) and
+// hands it to MapStore::Submit, whose callback (on a store thread) fills the batch's slot; slots
+// are written in order, one StartWrite at a time.
 // - Backpressure: at most kMaxUnanswered batches are read but not yet answered; beyond that the
 //   stream stops reading (no StartRead) until a response is written, so gRPC flow control slows
 //   the client down. When the store's queue is full (Submit: ResourceExhausted) the request is
 //   held, reading stops, and MapStore::OnRoom resubmits it — no polling, no unbounded buffer.
-// - Errors: a batch unusable as a whole gets a response with `error` and the stream goes on; an
-//   unknown map (NOT_FOUND), another map than the first request's (INVALID_ARGUMENT) or a store
-//   that fails ends the stream once the earlier batches are answered.
+//   Only that refusal (storage::IsQueueFull) is waited out: a map whose storage failed refuses
+//   with its error (ResourceExhausted for a full disk, too), which ends the stream at once.
+// - Errors: a batch unusable as a whole, or whose sequence the writer used for another batch, gets
+//   a response with `error` and the stream goes on; an unparsable message (INVALID_ARGUMENT
+//   naming its position), an unknown map (NOT_FOUND), another map than the first request's
+//   (INVALID_ARGUMENT) or a store that fails ends the stream once the earlier batches are
+//   answered.
 // - Shutdown (CallTracker::Drain → WindDown): reading stops, the batches in the store are answered,
 //   then the stream ends with UNAVAILABLE; a batch read but not submitted is dropped unanswered
 //   (the client resends what was not acknowledged; the store recognises repeats).
@@ -25,7 +30,9 @@
 // started at most once at a time, and nothing after Finish.
 #pragma once
 
+#include <grpcpp/impl/codegen/proto_utils.h>
 #include <grpcpp/server_context.h>
+#include <grpcpp/support/byte_buffer.h>
 #include <grpcpp/support/server_callback.h>
 
 #include <deque>
@@ -46,7 +53,7 @@
 
 namespace fremen::server {
 
-class IngestStream final : public grpc::ServerBidiReactor<v1::IngestRequest, v1::IngestResponse>,
+class IngestStream final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>,
                            public CallTracker::Drainable,
                            public std::enable_shared_from_this<IngestStream> {
  public:
@@ -70,10 +77,13 @@ class IngestStream final : public grpc::ServerBidiReactor<v1::IngestRequest, v1:
     bool failed = false;   // the store failed the batch: the stream ends with `failure`
     absl::Status failure;
     v1::IngestResponse response;
+    grpc::ByteBuffer bytes;  // response, serialized for its StartWrite
   };
 
   IngestStream(const ServiceDeps& deps, grpc::CallbackServerContext* context);
 
+  // Parses the message read into request_; INVALID_ARGUMENT naming its position if it is not one.
+  absl::Status Parse();
   // The map of request_: fixed by the first request, the same for every later one.
   absl::Status Route();
   // Converts and submits the held request (its slot: held_slot_). Called without the lock.
@@ -100,7 +110,9 @@ class IngestStream final : public grpc::ServerBidiReactor<v1::IngestRequest, v1:
   // submission that uses them.
   std::shared_ptr<storage::MapStore> map_;
   std::string map_name_;
-  v1::IngestRequest request_;  // gRPC's while reading_, the stream's while holding_
+  grpc::ByteBuffer message_;   // gRPC's while reading_, the stream's while holding_
+  v1::IngestRequest request_;  // parsed from message_; the stream's while holding_
+  uint64_t messages_ = 0;      // read so far, for errors naming a message's position
 
   std::mutex mutex_;
   std::deque<Slot> slots_;  // unanswered batches, in order; references stay valid at both ends

@@ -2,15 +2,19 @@
 // keeps running into a full queue (Submit: ResourceExhausted), so these tests exercise the
 // backpressure path — hold the batch, stop reading, resubmit from MapStore::OnRoom — which the
 // end-to-end tests (tests/ingest_service_test.cc) rarely reach with the daemon's 16M-observation
-// queue. Also: draining winds an idle stream down at once.
+// queue. Also: draining winds an idle stream down at once, and a map whose log fails (a full disk,
+// injected) ends its streams at once with the storage error instead of holding them as if the
+// queue were full.
 #include "server/ingest_stream.h"
 
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <thread>
 
 #include "server/ingest_service.h"
+#include "storage/env/fault_injection_env.h"
 #include "storage/store.h"
 #include "storage/testing/scans.h"
 #include "storage/testing/temp_dir.h"
@@ -26,6 +30,11 @@ class IngestStreamTest : public ::testing::Test {
   void SetUp() override {
     storage::StoreOptions options;
     options.max_queued_observations = kQueuedObservations;
+    disk_.set_before_sync([this]() -> absl::Status {
+      return disk_full_ ? absl::ResourceExhaustedError("write to the write-ahead log: No space left on device")
+                        : absl::OkStatus();
+    });
+    options.env = &disk_;
     auto store = storage::Store::Open(dir_.path(), options);
     ASSERT_TRUE(store.ok()) << store.status();
     store_ = *std::move(store);
@@ -47,7 +56,8 @@ class IngestStreamTest : public ::testing::Test {
       server_->Shutdown(std::chrono::system_clock::now());
     }
     if (store_ != nullptr) {
-      EXPECT_TRUE(store_->Close().ok());
+      const absl::Status closed = store_->Close();
+      if (!disk_full_) EXPECT_TRUE(closed.ok()) << closed;
     }
   }
 
@@ -66,6 +76,8 @@ class IngestStreamTest : public ::testing::Test {
     return request;
   }
 
+  std::atomic<bool> disk_full_ = false;  // the log's syncs fail with ENOSPC
+  storage::FaultInjectionEnv disk_;      // declared before the store, so it outlives it
   storage::testing::TempDir dir_;
   std::unique_ptr<storage::Store> store_;
   CallTracker calls_;
@@ -133,6 +145,38 @@ TEST_F(IngestStreamTest, DrainEndsAnIdleStreamAtOnceWithUnavailable) {
   const grpc::Status status = stream->Finish();
   EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAVAILABLE);
   EXPECT_NE(status.error_message().find("shutting down"), std::string::npos) << status.error_message();
+}
+
+TEST_F(IngestStreamTest, AFullDiskEndsTheLiveStreamAndEveryNewOneAtOnceWithTheStorageError) {
+  grpc::ClientContext live_context;
+  auto live = stub_->Ingest(&live_context);
+  ASSERT_TRUE(live->Write(Batch(1, 1)));
+  v1::IngestResponse response;
+  ASSERT_TRUE(live->Read(&response));
+  EXPECT_EQ(response.accepted(), kCellsPerBatch);
+
+  disk_full_ = true;
+  ASSERT_TRUE(live->Write(Batch(1, 2)));
+  EXPECT_FALSE(live->Read(&response));  // not durable: never acknowledged
+  const grpc::Status ended = live->Finish();
+  EXPECT_EQ(ended.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << ended.error_message();
+  EXPECT_NE(ended.error_message().find("No space left on device"), std::string::npos) << ended.error_message();
+
+  // A new stream on the failed map learns it from its first batch — not at its deadline, as when
+  // the storage error was taken for a full queue and waited out.
+  for (uint64_t writer : {1, 2}) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+    auto stream = stub_->Ingest(&context);
+    ASSERT_TRUE(stream->Write(Batch(writer, 3)));
+    EXPECT_FALSE(stream->Read(&response));
+    const grpc::Status refused = stream->Finish();
+    EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << refused.error_message();
+    EXPECT_NE(refused.error_message().find("map lab refuses writes"), std::string::npos) << refused.error_message();
+  }
+  auto map = store_->Map("lab");
+  ASSERT_TRUE(map.ok());
+  EXPECT_EQ((*map)->Stats().totals.observations, kCellsPerBatch);  // the acknowledged batch
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "storage/batch.h"
 
+#include <xxhash.h>
+
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -174,5 +176,7 @@ absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes) {
   if (batch.observation_count() > kMaxBatchObservations) return absl::DataLossError("batch: too many observations");
   return batch;
 }
+
+uint64_t BatchFingerprint(std::string_view encoded) { return XXH3_64bits(encoded.data(), encoded.size()); }
 
 }  // namespace fremen::storage

@@ -69,6 +69,9 @@ struct BatchAck {
   std::vector<Rejection> rejections;
   // The batch had been applied before (a retry): nothing was applied this time.
   bool duplicate = false;
+  // Not OK when the batch was refused as a whole and nothing of it applied, while the map goes on:
+  // AlreadyExists when its (writer, sequence) was used for another batch (storage/dedup_table.h).
+  absl::Status error;
   uint64_t lsn = 0;  // its place in the map's log
 };
 
@@ -91,5 +94,10 @@ BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector
 // Log payload encoding. Decode answers DataLoss on damaged bytes.
 std::string EncodeBatch(const ObservationBatch& batch);
 absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes);
+
+// What tells a retry of a batch from another batch under the same (writer, sequence): XXH3-64 of
+// its EncodeBatch bytes (the conversion from a request is deterministic, so a resent request gives
+// the same bytes). Persisted in checkpoints: the hash must never change.
+uint64_t BatchFingerprint(std::string_view encoded);
 
 }  // namespace fremen::storage

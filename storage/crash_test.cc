@@ -99,7 +99,7 @@ TEST(CrashTest, EveryAcknowledgedBatchSurvivesKillNineAndModelsMatchARecomputati
       EXPECT_GT(compared, 0u);
     }
     std::fprintf(stderr, "round %d: acked %llu held %llu\n", round, (unsigned long long)acked, (unsigned long long)held);
-    previous_acked = held;  // the next run re-sends 1..N: duplicates up to here
+    previous_acked = held;  // the next run continues after the store's last sequence
   }
   EXPECT_GT(applied_to_reference, 100u);  // the rounds did real work
 }

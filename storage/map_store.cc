@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <future>
 
+#include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
 #include "storage/cell_key.h"
 
@@ -20,6 +21,9 @@ namespace {
 // The first byte of a log record: what it holds.
 constexpr char kBatchRecord = 'B';    // an ObservationBatch follows
 constexpr char kPublishRecord = 'P';  // every shard republished its models here
+
+// Marks Submit's refusal for a full queue (IsQueueFull).
+constexpr char kQueueFullPayload[] = "type.fremen/storage.QueueFull";
 
 std::string ShardDir(const std::string& dir, uint32_t i) { return absl::StrCat(dir, "/shard-", i); }
 std::string LastUpdatePath(const std::string& dir) { return dir + "/last_update"; }
@@ -44,6 +48,10 @@ void ForEachShardInParallel(size_t shards, bool parallel, const std::function<vo
 }
 
 }  // namespace
+
+bool IsQueueFull(const absl::Status& status) {
+  return status.code() == absl::StatusCode::kResourceExhausted && status.GetPayload(kQueueFullPayload).has_value();
+}
 
 MapStore::MapStore(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings)
     : info_(std::move(info)), dir_(std::move(dir)), options_(options), settings_(std::move(settings)) {}
@@ -108,7 +116,8 @@ absl::Status MapStore::Recover() {
     }
     auto batch = DecodeBatch({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1});
     if (!batch.ok()) return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", batch.status().message()));
-    dedup_.Record(batch->writer_id, batch->sequence);
+    dedup_.Record(batch->writer_id, batch->sequence,
+                  BatchFingerprint({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1}));
     Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}};
     pending.ack = Classify(info_, pending.batch, pending.accept);
     SplitByShard(pending);
@@ -161,6 +170,7 @@ MapStore::Pending MapStore::Prepare(ObservationBatch batch, AckCallback done) co
   pending.ack = Classify(info_, pending.batch, pending.accept);
   pending.record.push_back(kBatchRecord);
   pending.record += EncodeBatch(pending.batch);
+  pending.fingerprint = BatchFingerprint(std::string_view(pending.record).substr(1));
   SplitByShard(pending);
   return pending;
 }
@@ -208,8 +218,10 @@ absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
     if (closing_) return absl::UnavailableError(absl::StrCat("map ", info_.name, " is closing"));
     if (!write_error_.ok()) return write_error_;
     if (!FitsLocked(n)) {
-      return absl::ResourceExhaustedError(absl::StrCat("map ", info_.name,
-                                                       " is behind on ingest: too many queued observations; retry"));
+      absl::Status full = absl::ResourceExhaustedError(
+          absl::StrCat("map ", info_.name, " is behind on ingest: too many queued observations; retry"));
+      full.SetPayload(kQueueFullPayload, absl::Cord());
+      return full;
     }
     return absl::OkStatus();
   };
@@ -233,7 +245,7 @@ absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
 void MapStore::OnRoom(uint64_t observations, std::function<void()> f) {
   {
     std::lock_guard lock(queue_mutex_);
-    if (!FitsLocked(observations) && !closing_) {
+    if (!FitsLocked(observations) && !closing_ && write_error_.ok()) {
       room_waiters_.push_back(std::move(f));
       return;
     }
@@ -248,7 +260,14 @@ absl::StatusOr<BatchAck> MapStore::Write(ObservationBatch batch) {
       !s.ok()) {
     return s;
   }
-  return future.get();
+  absl::StatusOr<BatchAck> ack = future.get();
+  if (ack.ok() && !ack->error.ok()) return ack->error;
+  return ack;
+}
+
+uint64_t MapStore::LastSequence(uint64_t writer) const {
+  std::lock_guard lock(dedup_mutex_);
+  return dedup_.LastSequence(writer);
 }
 
 absl::StatusOr<uint64_t> MapStore::RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress) {
@@ -296,8 +315,24 @@ absl::Status MapStore::WriteError() const {
 }
 
 void MapStore::Latch(const absl::Status& status) {
-  std::lock_guard lock(queue_mutex_);
-  if (write_error_.ok()) write_error_ = status;
+  std::vector<std::function<void()>> room;
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (!write_error_.ok()) return;
+    // A full disk stays ResourceExhausted; any other fault (an I/O error) is Unavailable: the map
+    // takes no writes until an operator fixes the cause and reopens it. The message keeps the cause.
+    const bool full = status.code() == absl::StatusCode::kResourceExhausted;
+    write_error_ = absl::Status(
+        full ? status.code() : absl::StatusCode::kUnavailable,
+        absl::StrCat("map ", info_.name,
+                     " refuses writes after a storage error (acknowledged data is kept; "
+                     "restart fremend once it is fixed): ",
+                     full ? "" : absl::StrCat(absl::StatusCodeToString(status.code()), ": "), status.message()));
+    room.swap(room_waiters_);
+  }
+  // Waiters for room would otherwise wait for ever (the queue may stay full of batches that will
+  // fail): they resubmit and learn the error.
+  for (auto& f : room) f();
 }
 
 void MapStore::CommitLoop() {
@@ -340,6 +375,7 @@ void MapStore::CommitLoop() {
       // Nothing of this stage is durable: answer it now. No checkpoint runs from now on (see
       // StartCheckpoint); reads go on.
       Latch(status);
+      status = WriteError();
       for (Pending& p : stage.group) p.done(status);
       stage.group.clear();
       std::erase_if(stage.controls, [&](Control& c) {
@@ -362,14 +398,20 @@ void MapStore::CommitLoop() {
 }
 
 void MapStore::LogGroup(std::vector<Pending>& group) {
+  std::lock_guard lock(dedup_mutex_);
   for (Pending& p : group) {
-    if (dedup_.Seen(p.batch.writer_id, p.batch.sequence)) {
+    const absl::StatusOr<bool> seen = dedup_.Seen(p.batch.writer_id, p.batch.sequence, p.fingerprint);
+    if (!seen.ok() || *seen) {
       p.ack = BatchAck{};
       p.ack.sequence = p.batch.sequence;
-      p.ack.duplicate = true;
+      p.ack.duplicate = seen.ok();
+      if (!seen.ok()) {
+        p.ack.error =
+            absl::Status(seen.status().code(), absl::StrCat("map ", info_.name, ": ", seen.status().message()));
+      }
       continue;
     }
-    dedup_.Record(p.batch.writer_id, p.batch.sequence);
+    dedup_.Record(p.batch.writer_id, p.batch.sequence, p.fingerprint);
     p.ack.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(p.record.data()), p.record.size()});
   }
 }
@@ -424,7 +466,7 @@ void MapStore::ApplyGroup(std::vector<Pending>& group) {
   // Every shard folds in its part of every batch, in batch order.
   std::vector<const Pending*> fresh;
   for (const Pending& p : group) {
-    if (!p.ack.duplicate) fresh.push_back(&p);
+    if (!p.ack.duplicate && p.ack.error.ok()) fresh.push_back(&p);
   }
   std::vector<ScanContext> scans;
   scans.reserve(fresh.size());
@@ -443,7 +485,7 @@ void MapStore::ApplyGroup(std::vector<Pending>& group) {
   }
   for (const Pending* p : fresh) {
     IndexLabels(p->batch.labels);
-    applied_dedup_.Record(p->batch.writer_id, p->batch.sequence);
+    applied_dedup_.Record(p->batch.writer_id, p->batch.sequence, p->fingerprint);
   }
   // Durable and visible: acknowledge.
   for (Pending& p : group) p.done(p.ack);

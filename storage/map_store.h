@@ -1,13 +1,20 @@
 // One open map: its shards, its write-ahead log and the committer thread that turns submitted
 // batches into durable, applied, acknowledged ones (storage/README.md, "Write path").
 //
-// Write path: Submit() validates a batch and queues it (ResourceExhausted when the queue is full:
-// the caller slows down — backpressure, not unbounded buffering). The committer takes every queued
-// batch, appends the new ones to the log and syncs once (group commit), has each shard's thread fold
-// its part in, and then calls each batch's callback with its acknowledgement. A (writer, sequence)
-// already applied is acknowledged as a duplicate and not applied again. Checkpoints (by log size or
-// on request) write the changed states of every shard to LMDB and drop the covered log segments.
-// Open() recovers: every shard from its checkpoint, then the log after it.
+// Write path: Submit() validates a batch and queues it (ResourceExhausted marked IsQueueFull when
+// the queue is full: the caller slows down — backpressure, not unbounded buffering). The committer
+// takes every queued batch, appends the new ones to the log and syncs once (group commit), has each
+// shard's thread fold its part in, and then calls each batch's callback with its acknowledgement.
+// A retry of a batch already applied — the same (writer, sequence) and the same content — is
+// acknowledged as a duplicate and not applied again; a (writer, sequence) used for other content is
+// refused (BatchAck::error, storage/dedup_table.h). Checkpoints (by log size or on request) write
+// the changed states of every shard to LMDB and drop the covered log segments. Open() recovers:
+// every shard from its checkpoint, then the log after it.
+//
+// Storage errors (a failed log sync, commit or checkpoint: a full disk, an I/O error) latch: from
+// then on every write is refused at once with that error (WriteError: ResourceExhausted for a full
+// disk, Unavailable for any other cause, named in the message), and waiters of OnRoom are woken,
+// so that no caller mistakes a failed map for a busy one.
 //
 // Reads run concurrently with writes and see every acknowledged batch.
 // Thread-safety: every public method may be called from any thread.
@@ -67,6 +74,11 @@ struct StoreOptions {
   bool probe_before_open = true;
 };
 
+// Whether `status` is Submit's refusal for a full queue — backpressure: resubmit once OnRoom calls
+// back — rather than a refusal that waiting does not cure (a latched storage error may be
+// ResourceExhausted too: a full disk).
+bool IsQueueFull(const absl::Status& status);
+
 struct MapStats {
   ShardStats totals;  // summed over shards
   uint64_t log_bytes = 0;
@@ -95,14 +107,21 @@ class MapStore {
 
   // --- writes ---
   // Validates and queues; `done` runs (on the committer thread) once the batch is durable and
-  // applied, or failed. An error returned here means `done` will not run.
+  // applied, or refused as a whole (an ack whose `error` is set: nothing applied, the map goes on),
+  // or failed (an error status: the map refuses writes from now on). An error returned here means
+  // `done` will not run: the batch is unusable (InvalidArgument, OutOfRange), the queue is full
+  // (IsQueueFull), the map is closing (Unavailable) or refuses writes (WriteError()).
   absl::Status Submit(ObservationBatch batch, AckCallback done);
-  // Submit and wait.
+  // Submit and wait. A batch refused as a whole comes back as its ack's error.
   absl::StatusOr<BatchAck> Write(ObservationBatch batch);
   // Runs `f` once when the queue can take a batch of `observations` — by the same rule Submit
-  // applies — on the committer thread, or at once when it can now. A streaming handler whose
-  // Submit was refused stops reading and resumes from here, instead of polling.
+  // applies — or the map stops taking writes (closing, or a latched error: then Submit tells why),
+  // on a store thread, or at once when either holds now. A streaming handler whose Submit was
+  // refused stops reading and resumes from here, instead of polling.
   void OnRoom(uint64_t observations, std::function<void()> f);
+  // The highest sequence of `writer` logged in this map (so applied, or to be applied before any
+  // later batch), 0 when none: where a writer that lost its count continues.
+  uint64_t LastSequence(uint64_t writer) const;
   // Checkpoints now and waits.
   absl::Status Checkpoint();
   // The update job's core (Shard::BeginPublication): republishes P, with its best order, of every
@@ -149,6 +168,7 @@ class MapStore {
     std::string record;                        // the log record
     std::vector<std::vector<uint64_t>> keys;   // accepted observations by shard
     std::vector<std::vector<float>> values;
+    uint64_t fingerprint = 0;  // BatchFingerprint of the record's batch
   };
   // Requests the committer serves between groups, in order.
   struct Control {
@@ -172,7 +192,8 @@ class MapStore {
   // Reports a repair through StoreOptions::log_warning.
   void Warn(const std::string& message) const;
   void CommitLoop();
-  // Appends the group's new batches to the log (marking retries as duplicates); wal_mutex_ held.
+  // Appends the group's new batches to the log (marking retries as duplicates, refusing reused
+  // sequences); wal_mutex_ held.
   void LogGroup(std::vector<Pending>& group);
   void Latch(const absl::Status& status);
   void ApplyLoop();
@@ -211,7 +232,8 @@ class MapStore {
   std::unique_ptr<ShardWorkers> workers_;
   std::unique_ptr<WalWriter> wal_;
   std::mutex wal_mutex_;      // the committer's appends and syncs, the applier's drops
-  DedupTable dedup_;          // committer only: what was logged
+  mutable std::mutex dedup_mutex_;  // held by the committer to change dedup_, by LastSequence to read it
+  DedupTable dedup_;                // the committer's: what was logged
   DedupTable applied_dedup_;  // applier only: what was applied, recorded by checkpoints
   uint64_t applied_lsn_ = 0;  // applier only
   std::optional<Control> publication_;     // applier only: the publication in progress

@@ -1,7 +1,8 @@
 // The C++ client's ingest session across daemon restarts: batches keep flowing through a SIGTERM
 // restart and a kill -9 on the same address, the session reconnects and resends what was not
 // acknowledged, and in the end every batch is applied exactly once — checked through the
-// per-state observation counts (GetStateModel) and the map's total (GetMapStats).
+// per-state observation counts (GetStateModel) and the map's total (GetMapStats). And a writer
+// that reboots and lost its count: a new session continues after its last sequence.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -105,6 +106,55 @@ TEST_F(ClientIngestResumeTest, EveryBatchIsAppliedExactlyOnceAcrossRestartsAndAK
   auto stats = client_->GetMapStats("doors");
   ASSERT_TRUE(stats.ok()) << stats.status();
   EXPECT_EQ(stats->observations(), kBatches * kStates);
+}
+
+TEST_F(ClientIngestResumeTest, ARebootedWriterContinuesAfterItsLastSequenceAndLosesNothing) {
+  client::IngestOptions options;
+  options.writer_id = 42;  // the robot's fixed id; its sequence counter is lost at every reboot
+  {
+    auto session = client_->OpenIngest("doors", options);
+    ASSERT_TRUE(session.ok()) << session.status();
+    EXPECT_EQ((*session)->first_sequence(), 1u);
+    SendBatches(**session, 0, 10);
+    ASSERT_TRUE((*session)->Close(absl::Seconds(60)).ok());
+  }
+  // Rebooted, and the daemon restarted meanwhile too: the session asks where to continue.
+  StopDaemon();
+  StartDaemon({"--listen", address_});
+  ASSERT_FALSE(HasFatalFailure());
+  auto rebooted = client_->OpenIngest("doors", options);
+  ASSERT_TRUE(rebooted.ok()) << rebooted.status();
+  EXPECT_EQ((*rebooted)->first_sequence(), 11u);
+  SendBatches(**rebooted, 10, 20);
+  ASSERT_TRUE((*rebooted)->Close(absl::Seconds(60)).ok());
+  const auto totals = (*rebooted)->totals();
+  EXPECT_EQ(totals.acknowledged, 10u);
+  EXPECT_EQ(totals.duplicates, 0u);
+  EXPECT_EQ(totals.refused, 0u);
+  for (uint64_t id = 1; id <= kStates; ++id) {
+    auto model = client_->GetStateModel("doors", State::WithId(id));
+    ASSERT_TRUE(model.ok()) << model.status();
+    ASSERT_TRUE(model->has_value()) << "state " << id;
+    EXPECT_EQ((*model)->observations(), 20u) << "state " << id;
+  }
+
+  // Told to count from 1 again, a session's new batches are refused naming where to continue —
+  // never acknowledged as duplicates and dropped.
+  options.first_sequence = 1;
+  auto counting_again = client_->OpenIngest("doors", options);
+  ASSERT_TRUE(counting_again.ok()) << counting_again.status();
+  SendBatches(**counting_again, 20, 21);
+  ASSERT_TRUE((*counting_again)->Close(absl::Seconds(60)).ok());
+  const std::vector<client::IngestAck> acks = (*counting_again)->TakeAcks();
+  ASSERT_EQ(acks.size(), 1u);
+  EXPECT_FALSE(acks[0].duplicate);
+  EXPECT_EQ(acks[0].error.code(), absl::StatusCode::kAlreadyExists) << acks[0].error;
+  EXPECT_THAT(acks[0].error.message(),
+              ::testing::HasSubstr("writer 42 sequence 1 was already used for a different batch; continue after "
+                                   "sequence 20"));
+  auto stats = client_->GetMapStats("doors");
+  ASSERT_TRUE(stats.ok()) << stats.status();
+  EXPECT_EQ(stats->observations(), 20 * kStates);
 }
 
 TEST_F(ClientIngestResumeTest, ASenderThreadKeepsSendingThroughAKillAndARestart) {

@@ -239,6 +239,26 @@ TEST_F(ClientLibraryTest, IngestSessionLabelsGenericStatesAndTopStatesRanksThem)
   EXPECT_FALSE(never->has_value());
 }
 
+TEST_F(ClientLibraryTest, AMessageTheDaemonCannotParseEndsTheSessionWithItsPosition) {
+  Create(GenericMap("doors"));
+  auto session = client_->OpenIngest("doors");
+  ASSERT_TRUE(session.ok()) << session.status();
+  ASSERT_TRUE((*session)->Send(*ScanBuilder(kStart).AddNamedState("front", 1).Build()).ok());
+  ASSERT_TRUE((*session)->Flush(absl::Seconds(30)).ok());
+  // Not UTF-8: protobuf sends the string field as it is (logging a complaint), the daemon cannot
+  // parse it — as with any message damaged on its way.
+  ScanBuilder damaged(kStart + 60);
+  damaged.AddNamedState("\xff\xfe", 1);
+  (void)(*session)->Send(*damaged.Build());
+  const absl::Status flushed = (*session)->Flush(absl::Seconds(30));
+  EXPECT_EQ(flushed.code(), absl::StatusCode::kInvalidArgument) << flushed;
+  EXPECT_THAT(flushed.message(), HasSubstr("message 2 of the stream: cannot parse IngestRequest"));
+  EXPECT_EQ((*session)->unacknowledged(), 1u);
+  EXPECT_EQ((*session)->totals().acknowledged, 1u);
+  EXPECT_EQ((*session)->Send(*ScanBuilder(kStart + 120).AddNamedState("front", 0).Build()).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
 TEST_F(ClientLibraryTest, IngestIntoAnUnknownMapFailsAtOpen) {
   auto session = client_->OpenIngest("nowhere");
   EXPECT_EQ(session.status().code(), absl::StatusCode::kNotFound);

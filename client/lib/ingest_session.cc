@@ -21,7 +21,6 @@ constexpr auto kWriterGrace = std::chrono::seconds(1);
 absl::StatusOr<std::unique_ptr<IngestSession>> IngestSession::Open(std::shared_ptr<Connection> connection,
                                                                    std::string map, IngestOptions options) {
   if (map.empty()) return absl::InvalidArgumentError("map is empty: name the map to ingest into");
-  if (options.first_sequence == 0) return absl::InvalidArgumentError("first_sequence must be at least 1");
   if (options.max_unacknowledged == 0) return absl::InvalidArgumentError("max_unacknowledged must be at least 1");
   // Fail now on an unknown map or a refused token, rather than at the first ack.
   v1::GetMapRequest request;
@@ -32,19 +31,35 @@ absl::StatusOr<std::unique_ptr<IngestSession>> IngestSession::Open(std::shared_p
   if (!exists.ok()) return exists;
   uint64_t writer = options.writer_id;
   while (writer == 0) writer = RandomSeed();
+  uint64_t first = options.first_sequence;
+  if (first == 0 && options.writer_id != 0) {
+    // A writer that may have sent before (and may have lost its count): continue after the map's
+    // last batch of it. A read, so retried like one.
+    v1::LastSequenceRequest last_request;
+    last_request.set_map(map);
+    last_request.set_writer_id(writer);
+    v1::LastSequenceResponse last;
+    absl::Status asked = connection->CallIdempotent({}, map, [&](grpc::ClientContext& context) {
+      return connection->ingest().LastSequence(&context, last_request, &last);
+    });
+    if (!asked.ok()) return asked;
+    first = last.last_sequence() + 1;
+  }
+  if (first == 0) first = 1;
   std::unique_ptr<IngestSession> session(
-      new IngestSession(std::move(connection), std::move(map), std::move(options), writer));
+      new IngestSession(std::move(connection), std::move(map), std::move(options), writer, first));
   session->thread_ = std::thread([s = session.get()] { s->Run(); });
   return session;
 }
 
 IngestSession::IngestSession(std::shared_ptr<Connection> connection, std::string map, IngestOptions options,
-                             uint64_t writer_id)
+                             uint64_t writer_id, uint64_t first_sequence)
     : connection_(std::move(connection)),
       map_(std::move(map)),
       options_(std::move(options)),
       writer_id_(writer_id),
-      next_sequence_(options_.first_sequence) {}
+      first_sequence_(first_sequence),
+      next_sequence_(first_sequence) {}
 
 IngestSession::~IngestSession() {
   {

@@ -5,9 +5,9 @@
 // How: every batch gets (writer_id, sequence) — sequences increase by one per Send — and stays in
 // the session until the daemon acknowledges it. When the stream breaks with UNAVAILABLE (daemon
 // restarting or gone, link lost), the session opens a new stream with exponential backoff and
-// resends every unacknowledged batch in order; the daemon answers a batch it had already applied
-// with duplicate = true and does not apply it again (it keeps the highest applied sequence per
-// writer, storage/dedup_table.h). So each batch is applied exactly once.
+// resends every unacknowledged batch in order, unchanged; the daemon answers a batch it had
+// already applied with duplicate = true and does not apply it again (it remembers the content of
+// each writer's recent sequences, storage/dedup_table.h). So each batch is applied exactly once.
 //
 // - Send blocks while max_unacknowledged batches await their ack (backpressure: memory stays
 //   bounded while the daemon is away), and returns the batch's sequence.
@@ -18,9 +18,13 @@
 // - An error that retrying cannot fix (unknown map, bad token, a store that refuses writes) or
 //   reconnecting for longer than reconnect_timeout ends the session: Send, Flush and Close return
 //   it from then on; unacknowledged() tells how many batches were not applied for sure.
-// - Reusing a writer_id across processes: start at a first_sequence above every sequence that
-//   writer used before, or the daemon takes the new batches for retries (a random writer_id, the
-//   default, avoids that).
+// - A writer_id used before (a robot that rebooted and lost its count): with first_sequence 0, the
+//   default, the session asks the daemon (IngestService.LastSequence) and starts after the
+//   writer's last sequence, so that nothing new is taken for a retry. A batch sent under a
+//   sequence the writer already used for other content is refused, never dropped silently: its
+//   ack's error is ALREADY_EXISTS, naming the sequence to continue after.
+// - An unparsable message (a corrupted link) ends the session with the daemon's INVALID_ARGUMENT,
+//   which names the message's position in the stream.
 //
 // Thread-safety: Send, Flush, Close, TakeAcks and the accessors may be called from any threads; a
 // background thread reads acks and reconnects. on_ack runs on that thread: it must not block or
@@ -82,10 +86,12 @@ struct IngestTotals {
 struct IngestOptions {
   // Who writes; 0 = a random id for this session.
   uint64_t writer_id = 0;
-  // The first batch's sequence. REQUIRES: ≥ 1. Default: 1.
-  uint64_t first_sequence = 1;
+  // The first batch's sequence; 0: one above the writer's last sequence in the map (asked at Open
+  // when writer_id is set; 1 for a random writer, which is new). Default: 0.
+  uint64_t first_sequence = 0;
   // Batches sent but not yet acknowledged before Send blocks. Bounds memory and what a reconnect
-  // resends. REQUIRES: ≥ 1. Default: 64.
+  // resends; the daemon recognises a resent batch among a writer's last 256 sequences, so keep it
+  // at most that. REQUIRES: ≥ 1. Default: 64.
   size_t max_unacknowledged = 64;
   // Give up when no stream has worked for this long (InfiniteDuration: never). Default: 5 min.
   absl::Duration reconnect_timeout = absl::Minutes(5);
@@ -98,8 +104,9 @@ struct IngestOptions {
 
 class IngestSession {
  public:
-  // Checks that `map` exists (NOT_FOUND otherwise, with the daemon's message) and starts the
-  // session. The stream itself opens with the first batch.
+  // Checks that `map` exists (NOT_FOUND otherwise, with the daemon's message), learns where the
+  // writer continues (see first_sequence) and starts the session. The stream itself opens with the
+  // first batch.
   static absl::StatusOr<std::unique_ptr<IngestSession>> Open(std::shared_ptr<Connection> connection, std::string map,
                                                              IngestOptions options = {});
   // Stops at once: batches not yet acknowledged are abandoned (call Close first to wait for them).
@@ -122,6 +129,8 @@ class IngestSession {
   // Batches sent but not acknowledged.
   size_t unacknowledged() const;
   uint64_t writer_id() const { return writer_id_; }
+  // The sequence the first Send got (or gets).
+  uint64_t first_sequence() const { return first_sequence_; }
   const std::string& map() const { return map_; }
 
  private:
@@ -135,7 +144,8 @@ class IngestSession {
     std::unique_ptr<grpc::ClientReaderWriter<v1::IngestRequest, v1::IngestResponse>> rw;
   };
 
-  IngestSession(std::shared_ptr<Connection> connection, std::string map, IngestOptions options, uint64_t writer_id);
+  IngestSession(std::shared_ptr<Connection> connection, std::string map, IngestOptions options, uint64_t writer_id,
+                uint64_t first_sequence);
 
   // The background thread: opens streams, reads acks, reconnects.
   void Run();
@@ -156,6 +166,7 @@ class IngestSession {
   const std::string map_;
   const IngestOptions options_;
   const uint64_t writer_id_;
+  const uint64_t first_sequence_;
 
   // Held while writing to the stream and while replacing it; taken before mutex_, never after.
   std::timed_mutex write_mutex_;

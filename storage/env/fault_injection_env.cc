@@ -26,6 +26,9 @@ class FaultInjectionEnv::File : public WritableFile {
   }
 
   absl::Status Sync() override {
+    if (env_->before_sync_) {
+      if (absl::Status s = env_->before_sync_(); !s.ok()) return s;
+    }
     std::lock_guard lock(env_->mutex_);
     if (absl::Status s = env_->EnterLocked(); !s.ok()) return s;
     return env_->SyncLocked(path_, *base_);
@@ -47,6 +50,8 @@ void FaultInjectionEnv::FailSyncs(int errno_value) {
   std::lock_guard lock(mutex_);
   sync_errno_ = errno_value;
 }
+
+void FaultInjectionEnv::set_before_sync(std::function<absl::Status()> hook) { before_sync_ = std::move(hook); }
 
 void FaultInjectionEnv::FailWrites(int errno_value) {
   std::lock_guard lock(mutex_);

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <random>
 #include <string>
@@ -44,6 +45,11 @@ class FaultInjectionEnv : public Env {
   // The next Append writes only a random part of its bytes (at least one, not all) and fails with
   // EIO.
   void TearNextWrite();
+
+  // Called before every file Sync, outside the env's lock (it may block, to hold a sync in
+  // progress); a non-OK status fails that Sync with it and makes nothing more durable. Default:
+  // none.
+  void set_before_sync(std::function<absl::Status()> hook);
 
   // Cuts the power now (see above).
   void CutPower();
@@ -98,6 +104,7 @@ class FaultInjectionEnv : public Env {
   int sync_errno_ = 0;
   int write_errno_ = 0;
   bool tear_next_write_ = false;
+  std::function<absl::Status()> before_sync_;  // set before the env is used
   bool tear_at_cut_ = false;
   bool power_cut_ = false;
   uint64_t operations_ = 0;

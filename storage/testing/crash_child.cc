@@ -1,7 +1,8 @@
 // The ingesting process of the crash test (storage/crash_test.cc): opens a map store, writes scans
-// 1..N of a fixed sweep (duplicates of earlier runs are acknowledged fast), and prints "ack <seq>"
-// for every acknowledged batch, flushed, so that the parent knows what was acknowledged before it
-// SIGKILLs this process at a random moment.
+// 1..N of a fixed sweep — from the first one the store does not have (MapStore::LastSequence, as a
+// writer that lost its count does) — and prints "ack <seq>" for every acknowledged batch, flushed,
+// so that the parent knows what was acknowledged before it SIGKILLs this process at a random
+// moment.
 //
 // Usage: fremen_crash_child DIR SCANS CELLS
 #include <cstdio>
@@ -27,7 +28,7 @@ int main(int argc, char** argv) {
   }
   const uint64_t scans = std::strtoull(argv[2], nullptr, 10);
   const size_t cells = std::strtoull(argv[3], nullptr, 10);
-  for (uint64_t i = 0; i < scans; ++i) {
+  for (uint64_t i = (*store)->LastSequence(1); i < scans; ++i) {
     auto ack = (*store)->Write(testing::SweepScan(map, 1, i, cells));
     if (!ack.ok()) {
       std::fprintf(stderr, "write: %s\n", std::string(ack.status().message()).c_str());

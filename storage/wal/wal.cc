@@ -279,6 +279,10 @@ absl::Status WalWriter::Sync() {
   if (status.ok()) status = file_->Sync();
   if (!status.ok()) {
     latched_ = absl::Status(status.code(), absl::StrCat("write-ahead log: ", status.message()));
+    // The batches of this group are answered with the error: cut what may have reached the file of
+    // them, so that a later recovery does not apply them after all. Best effort — if the cut fails
+    // too, they may come back, and a client's retry of one is then recognised as a duplicate.
+    if (!segments_.empty()) (void)env_->Truncate(SegmentPath(dir_, segments_.back().first_lsn), segment_size_);
     return latched_;
   }
   segment_size_ += buffer_.size();

@@ -21,7 +21,7 @@ from fremen.admin import AdminCalls
 from fremen.ingest import IngestSession
 from fremen.model import StateModel
 from fremen.retry import Backoff, retrying
-from fremen.v1 import (admin_pb2_grpc, common_pb2, ingest_pb2_grpc, maps_pb2, maps_pb2_grpc, query_pb2,
+from fremen.v1 import (admin_pb2_grpc, common_pb2, ingest_pb2, ingest_pb2_grpc, maps_pb2, maps_pb2_grpc, query_pb2,
                        query_pb2_grpc)
 
 DEFAULT_ADDRESS = "127.0.0.1:50051"
@@ -229,21 +229,33 @@ class Client(AdminCalls):
 
     # --- ingest ---
 
-    def ingest(self, map_name, writer_id=None, first_sequence=1, max_in_flight=64, timeout=None, resume=True):
+    def ingest(self, map_name, writer_id=None, first_sequence=None, max_in_flight=64, timeout=None, resume=True):
         """An IngestSession streaming batches into `map_name`.
 
-        (writer_id, sequence) identifies a batch: a robot that reconnects and resends batches not
-        yet acknowledged must use the same writer_id and sequence numbers (the daemon answers a
-        batch already applied with duplicate=True). writer_id defaults to a random number, a new
-        writer. timeout: seconds the whole session may last (None = no limit). resume: after the
-        stream fails with UNAVAILABLE, open a new one with the connect()'s backoff and resend the
-        unanswered batches (False, or a client without backoff: the session fails instead).
+        (writer_id, sequence) names a batch: a robot that reconnects and resends batches not yet
+        acknowledged must send them unchanged with the same writer_id and sequence numbers (the
+        daemon answers the same batch applied before with duplicate=True; other content under a
+        used sequence gets an Ack whose error is fremen.AlreadyExists). writer_id defaults to a
+        random number, a new writer. first_sequence: the first batch's number; None = one above
+        the writer's last sequence in the map (last_sequence()), so that a robot that rebooted and
+        lost its count sends new batches as new. timeout: seconds the whole session may last
+        (None = no limit). resume: after the stream fails with UNAVAILABLE, open a new one with
+        the connect()'s backoff and resend the unanswered batches (False, or a client without
+        backoff: the session fails instead).
         """
+        if first_sequence is None:
+            first_sequence = 1 if writer_id is None else self.last_sequence(map_name, writer_id) + 1
         if writer_id is None:
             writer_id = secrets.randbits(63) + 1
         return IngestSession(self._ingest.Ingest, map_name, self._metadata(map_name), writer_id, first_sequence,
                              max_in_flight, timeout, reconnect=self._reconnect if resume else None,
                              channel_ready=self._channel_ready)
+
+    def last_sequence(self, map_name, writer_id):
+        """The highest sequence number of `writer_id` the map has taken (0: none): a writer that
+        lost its count continues one above it."""
+        request = ingest_pb2.LastSequenceRequest(map=map_name, writer_id=writer_id)
+        return self._call(self._ingest.LastSequence, request, map_name).last_sequence
 
     # --- queries ---
 

@@ -13,14 +13,21 @@ batches sent but not yet answered, so send() blocks instead of queueing without 
 
 Resuming: when the stream fails with UNAVAILABLE (the daemon restarted, the network dropped) and
 the session has a fremen.Backoff, the reader opens a new stream after each of its pauses and puts
-the unanswered() batches on it again, with their writer id and sequence numbers: the daemon applies
-those it lacks and answers the others with duplicate=True, so every batch is answered once and
-applied once. Each stream has its own queue of requests, because gRPC's sender thread of a dead
+the unanswered() batches on it again, unchanged, with their writer id and sequence numbers: the
+daemon applies those it lacks and answers the others with duplicate=True (it recognises the same
+batch among a writer's last 256 sequences), so every batch is answered once and applied once.
+
+Writers: a batch is a duplicate only if it is the same batch. Other content under a sequence the
+writer already used (a robot that rebooted and counts from 1 again) is refused, never dropped: its
+Ack's error is a fremen.AlreadyExists naming the sequence to continue after. Client.ingest() with
+a writer_id and no first_sequence starts after the writer's last sequence in the map, so that a
+rebooted writer loses nothing. Each stream has its own queue of requests, because gRPC's sender thread of a dead
 stream may still take one batch from its queue (that batch is among the unanswered ones resent).
 
 A batch refused as a whole comes back as an Ack whose `error` is set (the stream goes on); a stream
-that fails otherwise (unknown map, missing token, the daemon away longer than the backoff allows)
-makes the next send/wait/close raise the fremen.Error. Its unanswered() batches may then have been
+that fails otherwise (unknown map, missing token, a message the daemon cannot parse —
+InvalidArgument naming its position —, the daemon away longer than the backoff allows) makes the
+next send/wait/close raise the fremen.Error. Its unanswered() batches may then have been
 applied or not: a new session of the same writer id resend()s them, and the daemon applies each
 exactly once. Thread-safety: one thread sends; wait/close from that thread too.
 """
@@ -185,7 +192,7 @@ class IngestSession:
             self._lock.wait_for(lambda: self._failure or self._ended or len(self._unanswered) < self._max_in_flight)
             self._raise_if_ended()
             request.sequence = self.next_sequence if sequence is None else sequence
-            # Numbers only go up: a writer's batch at or below its highest applied one is a retry.
+            # Numbers only go up, so that the next batch is never under a sequence already used.
             self.next_sequence = max(self.next_sequence, request.sequence + 1)
             self._unanswered.append(request)
             # Under the lock: a resumed stream takes either this batch from unanswered or this

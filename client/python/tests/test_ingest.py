@@ -1,6 +1,7 @@
 """Client.ingest sessions against a real fremend: batches of every kind and their acknowledgements
 (accepted and rejected counts with reasons), batches refused as a whole, retries recognised as
-duplicates, many batches in flight, and a stream that fails."""
+duplicates, a writer that lost its count, many batches in flight, a stream that fails, and a
+message the daemon cannot parse."""
 
 import math
 import os
@@ -10,6 +11,8 @@ import unittest
 import grpc
 
 import fremen
+from fremen.ingest import IngestSession
+from fremen.v1 import ingest_pb2
 from fremend_process import DaemonTestCase
 
 T = 1.7e9
@@ -85,6 +88,54 @@ class IngestTest(DaemonTestCase):
         self.assertFalse(new.duplicate)
         self.assertEqual(new.sequence, 3)
         self.assertEqual(self.client.stats("doors").observations, 3)
+
+    def test_a_rebooted_writer_continues_after_its_last_sequence_and_loses_nothing(self):
+        self.client.create_map("doors")
+        self.assertEqual(self.client.last_sequence("doors", 9), 0)
+        with self.client.ingest("doors", writer_id=9) as session:
+            for i in range(3):
+                self.assertEqual(session.send(T + i, [1], names=["a"]), i + 1)
+        self.assertEqual(self.client.last_sequence("doors", 9), 3)
+        # The robot rebooted and knows its id, not its count: the session asks the daemon.
+        with self.client.ingest("doors", writer_id=9) as rebooted:
+            self.assertEqual(rebooted.send(T + 3, [0], names=["a"]), 4)
+            (ack,) = rebooted.wait()
+        self.assertTrue(ack.ok)
+        self.assertFalse(ack.duplicate)
+        self.assertEqual(self.client.stats("doors").observations, 4)
+        # Counting from 1 again with new data: refused naming where to continue, not dropped as a
+        # duplicate.
+        with self.client.ingest("doors", writer_id=9, first_sequence=1) as counting_again:
+            counting_again.send(T + 4, [1], names=["b"])
+            (refused,) = counting_again.wait()
+        self.assertFalse(refused.duplicate)
+        self.assertIsInstance(refused.error, fremen.AlreadyExists)
+        self.assertEqual(refused.error.code, grpc.StatusCode.ALREADY_EXISTS)
+        self.assertIn("writer 9 sequence 1 was already used for a different batch; continue after sequence 4",
+                      refused.error.message)
+        self.assertEqual(self.client.stats("doors").observations, 4)
+
+    def test_a_message_the_daemon_cannot_parse_ends_the_session_naming_its_position(self):
+        self.client.create_map("doors")
+        # A link that damages the second message on its way: its bytes cut short.
+        def damaging(request):
+            data = request.SerializeToString()
+            return data[:-2] if request.sequence == 2 else data
+        channel = grpc.insecure_channel(self.daemon.address)
+        self.addCleanup(channel.close)
+        method = channel.stream_stream("/fremen.v1.IngestService/Ingest", request_serializer=damaging,
+                                       response_deserializer=ingest_pb2.IngestResponse.FromString)
+        session = IngestSession(method, "doors", [], writer_id=3, first_sequence=1, max_in_flight=8, timeout=60)
+        session.send(T, [1], names=["a"])
+        self.assertEqual(len(session.wait()), 1)
+        session.send(T + 1, [1], names=["a"])
+        session.send(T + 2, [1], names=["a"])
+        with self.assertRaises(fremen.InvalidArgument) as raised:
+            session.wait(timeout=30)
+        self.assertEqual(raised.exception.code, grpc.StatusCode.INVALID_ARGUMENT)
+        self.assertIn("message 2 of the stream: cannot parse IngestRequest", raised.exception.message)
+        self.assertEqual([b.sequence for b in session.unanswered()], [2, 3])
+        self.assertEqual(self.client.stats("doors").observations, 1)
 
     def test_many_batches_in_flight_are_answered_in_order(self):
         self.client.create_map("lab", size=(40, 30), resolution=0.5)

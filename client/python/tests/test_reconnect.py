@@ -181,6 +181,9 @@ class FirstStreamStuck:
             return StuckCall()
         return self.stub.Ingest(requests, metadata=metadata, timeout=timeout)
 
+    def __getattr__(self, name):  # the stub's other methods (LastSequence), unchanged
+        return getattr(self.stub, name)
+
 
 class StuckStreamTest(DaemonTestCase):
     def setUp(self):
