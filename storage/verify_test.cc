@@ -13,6 +13,7 @@
 #include "storage/lmdb/lmdb_env.h"
 #include "storage/map_store.h"
 #include "storage/shard_records.h"
+#include "storage/store.h"
 #include "storage/testing/scans.h"
 #include "storage/testing/temp_dir.h"
 
@@ -258,6 +259,32 @@ TEST(VerifyTest, AnOpenMapVerifiesCleanWhileItServes) {
   EXPECT_EQ(report.shards[0].checkpoint_lsn, 10u);
   // The map still takes writes after it.
   EXPECT_TRUE((*map)->Write(SweepScan(info, 1, 20, 100)).ok());
+}
+
+TEST(VerifyTest, ARestoreOfADamagedBackupIsRefusedAndCreatesNothing) {
+  TempDir dir, backup;
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto info = (*store)->CreateMap(GridMap("source", 64, 64, 1, 2));
+  ASSERT_TRUE(info.ok()) << info.status();
+  {
+    auto map = (*store)->Map("source");
+    ASSERT_TRUE(map.ok());
+    for (uint64_t i = 0; i < 40; ++i) ASSERT_TRUE((*map)->Write(SweepScan(*info, 1, i, 800)).ok());
+  }
+  const std::string copy = backup.path() + "/copy";
+  ASSERT_TRUE((*store)->BackupMap("source", copy).ok());
+  EXPECT_TRUE(VerifyShards(copy, *info, {}).clean());
+  ASSERT_TRUE((*store)->RestoreMap(copy, "intact").ok());  // a sound backup restores
+
+  const std::string file = copy + "/shard-1/data.mdb";
+  WriteAt(file, (fs::file_size(file) / 4096 / 2) * 4096, std::vector<uint8_t>(4096, 0));
+  const auto maps_before = std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator());
+  const auto restored = (*store)->RestoreMap(copy, "restored");
+  ASSERT_TRUE(absl::IsDataLoss(restored.status())) << restored.status();
+  EXPECT_TRUE(absl::StrContains(restored.status().message(), "shard-1/data.mdb")) << restored.status();
+  EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("restored").status()));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator()), maps_before);
 }
 
 }  // namespace
