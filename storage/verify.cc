@@ -20,6 +20,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "storage/batch.h"
+#include "storage/catalog.h"
 #include "storage/cell_key.h"
 #include "storage/dedup_table.h"
 #include "storage/lmdb/lmdb_env.h"
@@ -568,6 +569,65 @@ VerifyReport VerifyMap(const std::string& dir, const MapInfo& info, const Verify
 
 VerifyReport VerifyShards(const std::string& dir, const MapInfo& info, const VerifyOptions& options) {
   return Verify(dir, info, options, false);
+}
+
+bool DataDirVerifyReport::clean() const {
+  return problems.empty() && std::all_of(maps.begin(), maps.end(), [](const VerifyReport& m) { return m.clean(); });
+}
+
+DataDirVerifyReport VerifyDataDir(const std::string& data_dir, const VerifyOptions& options) {
+  DataDirVerifyReport report;
+  auto catalog = Catalog::OpenReadOnly(data_dir + "/catalog");
+  if (!catalog.ok()) {
+    report.problems.push_back({"catalog/data.mdb", "", absl::StrCat("cannot be opened: ", catalog.status().message())});
+    return report;
+  }
+  std::vector<MapInfo> maps;
+  absl::flat_hash_set<uint64_t> ids;
+  const absl::Status walked = (*catalog)->ForEachRecord([&](const std::string& name,
+                                                            const absl::StatusOr<MapInfo>& info) {
+    const std::string where = absl::StrCat("record of map \"", absl::CHexEscape(name), "\"");
+    if (!info.ok()) {
+      report.problems.push_back({"catalog/data.mdb", where, std::string(info.status().message())});
+    } else if (info->name != name) {
+      report.problems.push_back({"catalog/data.mdb", where, absl::StrCat("holds map \"", info->name, "\"")});
+    } else if (!ids.insert(info->id).second) {
+      report.problems.push_back({"catalog/data.mdb", where, absl::StrCat("id ", info->id, " is another map's too")});
+    } else {
+      maps.push_back(*info);
+    }
+  });
+  if (!walked.ok()) {
+    report.problems.push_back({"catalog/data.mdb", "", absl::StrCat("cannot be read to its end: ", walked.message())});
+  }
+  catalog->reset();
+  // Directories the catalog does not name: a store opening this data directory removes them.
+  if (DIR* d = opendir((data_dir + "/maps").c_str())) {
+    while (dirent* e = readdir(d)) {
+      const std::string entry = e->d_name;
+      if (entry == "." || entry == "..") continue;
+      uint64_t id = 0;
+      const bool numeric = !entry.empty() && entry.size() <= 20 &&
+                           std::all_of(entry.begin(), entry.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+                           std::sscanf(entry.c_str(), "%" SCNu64, &id) == 1 && std::to_string(id) == entry;
+      if (!numeric || !ids.contains(id)) {
+        report.problems.push_back(
+            {absl::StrCat("maps/", entry), "", "a map directory the catalog does not name (a lost catalog record?)"});
+      }
+    }
+    closedir(d);
+  }
+  for (const MapInfo& info : maps) {
+    const std::string dir = absl::StrCat(data_dir, "/maps/", info.id);
+    struct stat st;
+    if (stat(dir.c_str(), &st) != 0) {
+      report.problems.push_back(
+          {absl::StrCat("maps/", info.id), "", absl::StrCat("map \"", info.name, "\" has no directory")});
+      continue;
+    }
+    report.maps.push_back(VerifyMap(dir, info, options));
+  }
+  return report;
 }
 
 std::string FormatProblem(const VerifyProblem& problem) {

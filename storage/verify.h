@@ -92,6 +92,21 @@ VerifyReport VerifyMap(const std::string& dir, const MapInfo& info, const Verify
 // Shards only (a backup holds no log): the same checks as VerifyMap without the log's.
 VerifyReport VerifyShards(const std::string& dir, const MapInfo& info, const VerifyOptions& options);
 
+// What a whole data directory holds (storage/store.h: catalog/, maps/<id>/).
+struct DataDirVerifyReport {
+  // Of the catalog and the maps directory; files relative to the data directory: a catalog record
+  // that does not decode, a map whose directory is missing, a directory no catalog record names.
+  std::vector<VerifyProblem> problems;
+  // Every map the catalog lists, in name order.
+  std::vector<VerifyReport> maps;
+
+  bool clean() const;
+};
+
+// Verifies the catalog and every map of a data directory at rest (no daemon running on it: the
+// caller holds its lock, server/data_dir_lock.h). The catalog is opened read-only.
+DataDirVerifyReport VerifyDataDir(const std::string& data_dir, const VerifyOptions& options);
+
 // "shard-2/data.mdb: dynamic record of state 1234: <what>" — one line, no map name.
 std::string FormatProblem(const VerifyProblem& problem);
 

@@ -287,5 +287,35 @@ TEST(VerifyTest, ARestoreOfADamagedBackupIsRefusedAndCreatesNothing) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator()), maps_before);
 }
 
+TEST(VerifyTest, ADataDirectoryIsVerifiedMapByMapWithItsCatalog) {
+  TempDir dir;
+  {
+    auto store = Store::Open(dir.path(), {});
+    ASSERT_TRUE(store.ok()) << store.status();
+    for (const char* name : {"a", "b"}) {
+      auto info = (*store)->CreateMap(GridMap(name, 32, 32, 1, 1));
+      ASSERT_TRUE(info.ok()) << info.status();
+      auto map = (*store)->Map(name);
+      ASSERT_TRUE(map.ok());
+      for (uint64_t i = 0; i < 5; ++i) ASSERT_TRUE((*map)->Write(SweepScan(*info, 1, i, 100)).ok());
+    }
+  }
+  DataDirVerifyReport report = VerifyDataDir(dir.path(), {});
+  EXPECT_TRUE(report.clean());
+  ASSERT_EQ(report.maps.size(), 2u);
+  EXPECT_EQ(report.maps[0].map, "a");
+  EXPECT_EQ(report.maps[1].map, "b");
+  EXPECT_EQ(report.maps[1].log.last_lsn, 5u);
+
+  // A directory the catalog does not name is reported (a store opening the directory would remove it).
+  fs::create_directories(dir.path() + "/maps/999/shard-0");
+  report = VerifyDataDir(dir.path(), {});
+  EXPECT_FALSE(report.clean());
+  ASSERT_EQ(report.problems.size(), 1u);
+  EXPECT_EQ(report.problems[0].file, "maps/999");
+  EXPECT_EQ(report.maps.size(), 2u);
+  EXPECT_TRUE(fs::exists(dir.path() + "/maps/999"));
+}
+
 }  // namespace
 }  // namespace fremen::storage
