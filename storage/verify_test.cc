@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <thread>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
@@ -285,6 +287,37 @@ TEST(VerifyTest, ARestoreOfADamagedBackupIsRefusedAndCreatesNothing) {
   EXPECT_TRUE(absl::StrContains(restored.status().message(), "shard-1/data.mdb")) << restored.status();
   EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("restored").status()));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator()), maps_before);
+}
+
+TEST(VerifyTest, AnOpenMapVerifiesCleanWhileBatchesAndCheckpointsGoOn) {
+  TempDir dir;
+  const MapInfo info = GridMap("busy", 64, 64, 1, 2);
+  StoreOptions options;
+  options.checkpoint_log_bytes = 64 << 10;  // checkpoints (and dropped segments) all along
+  options.log_segment_bytes = 16 << 10;
+  auto map = MapStore::Open(info, dir.path(), options);
+  ASSERT_TRUE(map.ok()) << map.status();
+  for (uint64_t i = 0; i < 20; ++i) ASSERT_TRUE((*map)->Write(SweepScan(info, 1, i, 200)).ok());
+  std::atomic<bool> stop = false;
+  std::atomic<uint64_t> written = 0, failed = 0;
+  std::thread writer([&] {
+    for (uint64_t i = 20; !stop.load(); ++i) {
+      if ((*map)->Write(SweepScan(info, 1, i, 200)).ok()) {
+        written.fetch_add(1);
+      } else {
+        failed.fetch_add(1);
+      }
+    }
+  });
+  std::vector<VerifyReport> reports;
+  for (int round = 0; round < 5; ++round) reports.push_back((*map)->Verify());
+  stop = true;
+  writer.join();
+  EXPECT_EQ(failed.load(), 0u);
+  for (const VerifyReport& report : reports) {
+    EXPECT_TRUE(report.clean()) << Describe(report);
+    EXPECT_GE(report.log.last_lsn, 20u);
+  }
 }
 
 TEST(VerifyTest, ADataDirectoryIsVerifiedMapByMapWithItsCatalog) {
