@@ -46,7 +46,6 @@ constexpr uint8_t kPublishRecord = 'P';
 
 std::string ShardFile(uint32_t shard) { return absl::StrCat("shard-", shard, "/data.mdb"); }
 std::string_view View(std::span<const uint8_t> b) { return {reinterpret_cast<const char*>(b.data()), b.size()}; }
-std::span<const uint8_t> Bytes(std::string_view s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
 
 uint64_t FileSize(const std::string& path) {
   struct stat st;
