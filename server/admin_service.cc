@@ -16,6 +16,7 @@
 #include "server/operation_convert.h"
 #include "server/query_convert.h"
 #include "storage/catalog.h"
+#include "storage/verify.h"
 
 namespace fremen::server {
 
@@ -30,6 +31,7 @@ constexpr MethodSpec kCancelOperation{"CancelOperation", Access::kWrite, /*block
 constexpr MethodSpec kBackupMap{"BackupMap", Access::kWrite, /*blocking=*/true};
 constexpr MethodSpec kRestoreMap{"RestoreMap", Access::kWrite, /*blocking=*/true};
 constexpr MethodSpec kGetServerStatus{"GetServerStatus", Access::kRead, /*blocking=*/true};
+constexpr MethodSpec kCheckMap{"CheckMap", Access::kRead, /*blocking=*/true};
 
 constexpr char kOperationPrefix[] = "operations/";
 
@@ -52,6 +54,34 @@ absl::StatusOr<std::string> OptionalMapName(const grpc::ServerContextBase& conte
 absl::Status RenameRestoreFields(const absl::Status& status) {
   if (status.code() != absl::StatusCode::kInvalidArgument || !absl::StartsWith(status.message(), "name")) return status;
   return absl::InvalidArgumentError(absl::StrCat("map", status.message().substr(4)));
+}
+
+void VerifyReportToProto(const storage::VerifyReport& report, v1::CheckMapResponse& response) {
+  response.set_map(report.map);
+  response.set_clean(report.clean());
+  for (const storage::VerifyProblem& p : report.problems) {
+    v1::CheckProblem* problem = response.add_problems();
+    problem->set_file(p.file);
+    problem->set_location(p.where);
+    problem->set_description(p.what);
+  }
+  for (const std::string& note : report.notes) response.add_notes(note);
+  for (const storage::ShardVerifyReport& s : report.shards) {
+    v1::ShardCheck* shard = response.add_shards();
+    shard->set_shard(s.shard);
+    shard->set_records(s.records);
+    shard->set_record_bytes(s.record_bytes);
+    shard->set_file_bytes(s.file_bytes);
+    shard->set_checkpoint_lsn(s.checkpoint_lsn.value_or(0));
+    shard->set_read_to_end(s.read);
+  }
+  v1::LogCheck* log = response.mutable_log();
+  log->set_segments(report.log.segments);
+  log->set_records(report.log.records);
+  log->set_bytes(report.log.bytes);
+  log->set_first_lsn(report.log.first_lsn);
+  log->set_last_lsn(report.log.last_lsn);
+  log->set_torn_tail_bytes(report.log.torn_tail_bytes);
 }
 
 }  // namespace
@@ -219,10 +249,35 @@ absl::Status AdminServiceImpl::Restore(const v1::RestoreMapRequest& request, con
   auto store = deps_.store->Get();
   if (!store.ok()) return store.status();
   auto info = (*store)->RestoreMap(*dir, *name);
+  if (absl::IsDataLoss(info.status())) Log()->warn("restore refused: {}", std::string(info.status().message()));
   if (!info.ok()) return RenameRestoreFields(info.status());
   MapInfoToProto(*info, *response.mutable_map());
   Log()->info("map {} restored from {}", info->name, *dir);
   return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::CheckMap(grpc::CallbackServerContext* context,
+                                                     const v1::CheckMapRequest* request,
+                                                     v1::CheckMapResponse* response) {
+  return ServeUnary(deps_, context, kCheckMap, [this, context, request, response]() -> absl::Status {
+    auto name = ResolveMapName(*context, request->map(), "map");
+    if (!name.ok()) return name.status();
+    auto store = deps_.store->Get();
+    if (!store.ok()) return store.status();
+    auto map = (*store)->Map(*name);
+    if (!map.ok()) return map.status();
+    const absl::Time start = admin_.clock->Now();
+    const storage::VerifyReport report = (*map)->Verify();
+    VerifyReportToProto(report, *response);
+    response->set_duration_seconds(absl::ToDoubleSeconds(admin_.clock->Now() - start));
+    if (report.clean()) {
+      Log()->info("check of map {}: clean", *name);
+    } else {
+      Log()->warn("check of map {}: {} problems, the first: {}", *name, report.problems.size(),
+                  storage::FormatProblem(report.problems.front()));
+    }
+    return absl::OkStatus();
+  });
 }
 
 grpc::ServerUnaryReactor* AdminServiceImpl::GetServerStatus(grpc::CallbackServerContext* context,

@@ -2,8 +2,9 @@
 // backups and restores of maps, and the server's status.
 //
 // RunUpdate, GetOperation, ListOperations and CancelOperation only touch the operation registry and
-// the catalog, and run inline; BackupMap and RestoreMap copy files and GetServerStatus reads every
-// map's statistics, so they run on the blocking pool. Write methods (RunUpdate, CancelOperation,
+// the catalog, and run inline; BackupMap and RestoreMap copy files, CheckMap reads a whole map
+// (storage/verify.h) and GetServerStatus reads every map's statistics, so they run on the blocking
+// pool. Write methods (RunUpdate, CancelOperation,
 // BackupMap, RestoreMap) need a write token when tokens are configured.
 // Thread-safety: gRPC calls the handlers from any thread; the registry is thread-safe and the
 // service's one mutable member, the backups in progress, has its own mutex.
@@ -54,6 +55,8 @@ class AdminServiceImpl final : public v1::AdminService::CallbackService {
   grpc::ServerUnaryReactor* GetServerStatus(grpc::CallbackServerContext* context,
                                             const v1::GetServerStatusRequest* request,
                                             v1::GetServerStatusResponse* response) override;
+  grpc::ServerUnaryReactor* CheckMap(grpc::CallbackServerContext* context, const v1::CheckMapRequest* request,
+                                     v1::CheckMapResponse* response) override;
 
  private:
   // The operation `name` (field "name"), checked against the map the call names, if any.

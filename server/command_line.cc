@@ -37,11 +37,16 @@ CommandLine ParseCommandLine(int argc, const char* const* argv, std::ostream& ou
   CLI::App app("fremend: the fremen FreMEn map database daemon (gRPC)", "fremend");
   app.footer(
       "Settings: embedded defaults, then --config FILE, then these flags (see deploy/fremend.conf.example).\n"
-      "Exit codes: 0 stopped by SIGTERM/SIGINT, 1 failure, 2 bad command line or configuration.");
+      "Exit codes: 0 stopped by SIGTERM/SIGINT, 1 failure, 2 bad command line or configuration;\n"
+      "with --verify: 0 clean, 1 a problem found.");
   std::string config_file;
   bool check_config = false;
   app.add_option("--config", config_file, "config file of `key = value` lines")->type_name("FILE");
   app.add_flag("--check-config", check_config, "check the configuration (and the files it names), then exit");
+  bool verify = false;
+  app.add_flag("--verify", verify,
+               "verify every map of data_dir offline (every record, log and checkpoint), print a report, then exit: "
+               "0 clean, 1 problems found; refused while a daemon runs on data_dir");
   app.set_version_flag("--version", FREMEN_VERSION);
 
   // Flags keep their text until the file has been read: they override it.
@@ -82,7 +87,7 @@ CommandLine ParseCommandLine(int argc, const char* const* argv, std::ostream& ou
     out << "config OK\n";
     return {std::nullopt, kExitOk};
   }
-  return {std::move(config), kExitOk};
+  return {.config = std::move(config), .exit_code = kExitOk, .verify = verify};
 }
 
 }  // namespace fremen::server

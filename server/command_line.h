@@ -1,5 +1,6 @@
 // fremend's command line: --config FILE, a flag for every setting of the config table
-// (--listen, --data-dir, ...: the key with '-' for '_'), --check-config, --version and --help.
+// (--listen, --data-dir, ...: the key with '-' for '_'), --check-config, --verify, --version and
+// --help.
 // Settings come from the embedded defaults, then the config file, then the flags.
 // Pure apart from reading the files the settings name; thread-compatible.
 #pragma once
@@ -22,6 +23,8 @@ inline constexpr int kExitBadConfig = 2;
 struct CommandLine {
   std::optional<ServerConfig> config;
   int exit_code = kExitOk;
+  // --verify: check the data directory offline (server/verify_command.h) instead of serving it.
+  bool verify = false;
 };
 
 CommandLine ParseCommandLine(int argc, const char* const* argv, std::ostream& out, std::ostream& err);

@@ -52,6 +52,16 @@ TEST_F(CommandLineTest, NoArgumentsRunWithTheDefaults) {
   EXPECT_EQ(outcome.result.config->listen, "127.0.0.1:50051");
 }
 
+TEST_F(CommandLineTest, VerifyKeepsTheSettingsAndAsksForTheOfflineCheck) {
+  const std::string config = WriteConfig("data_dir = /srv/fremen\n");
+  const Outcome outcome = Parse({"--config", config, "--verify"});
+  ASSERT_TRUE(outcome.result.config.has_value()) << outcome.err;
+  EXPECT_TRUE(outcome.result.verify);
+  EXPECT_EQ(outcome.result.exit_code, kExitOk);
+  EXPECT_EQ(outcome.result.config->data_dir, "/srv/fremen");
+  EXPECT_FALSE(Parse({}).result.verify);
+}
+
 TEST_F(CommandLineTest, FlagsOverrideTheFileWhichOverridesTheDefaults) {
   const std::string config = WriteConfig("listen = 0.0.0.0:7000\ndata_dir = /srv/fremen\nshards = 4\n");
   const Outcome outcome = Parse({"--config", config, "--listen", "127.0.0.1:7001", "--keepalive-time", "45s"});

@@ -2,8 +2,8 @@
 // the daemon step by step (server/daemon.h) and waits for SIGTERM or SIGINT to stop it.
 //
 // Exit codes (server/command_line.h): 0 stopped by a signal with every acknowledged write flushed
-// (or --help, --version, --check-config), 1 failure while starting or stopping, 2 bad command line
-// or configuration.
+// (or --help, --version, --check-config, a clean --verify), 1 failure while starting or stopping
+// (or problems found by --verify), 2 bad command line or configuration.
 #include <spdlog/spdlog.h>
 
 #include <csignal>
@@ -12,6 +12,7 @@
 #include "server/command_line.h"
 #include "server/daemon.h"
 #include "server/logging.h"
+#include "server/verify_command.h"
 
 namespace {
 
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   using namespace fremen::server;
   CommandLine command_line = ParseCommandLine(argc, argv, std::cout, std::cerr);
   if (!command_line.config) return command_line.exit_code;
+  if (command_line.verify) return VerifyDataDirCommand(*command_line.config, std::cout, std::cerr);
 
   const sigset_t signals = TerminationSignals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);

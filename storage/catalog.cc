@@ -39,6 +39,29 @@ absl::StatusOr<std::unique_ptr<Catalog>> Catalog::Open(const std::string& dir) {
   return std::unique_ptr<Catalog>(new Catalog(*std::move(env)));
 }
 
+absl::StatusOr<std::unique_ptr<Catalog>> Catalog::OpenReadOnly(const std::string& dir) {
+  LmdbOptions options;
+  options.databases = {kMapsDb, kMetaDb};
+  options.read_only = true;
+  options.no_lock = true;
+  auto env = LmdbEnv::Open(dir, options);
+  if (!env.ok()) return env.status();
+  return std::unique_ptr<Catalog>(new Catalog(*std::move(env)));
+}
+
+absl::Status Catalog::ForEachRecord(
+    const std::function<void(const std::string&, const absl::StatusOr<MapInfo>&)>& f) const {
+  return env_->Read([&](LmdbTxn& txn) -> absl::Status {
+    auto maps = txn.Db(kMapsDb);
+    if (absl::IsNotFound(maps.status())) return absl::OkStatus();
+    if (!maps.ok()) return maps.status();
+    return txn.ScanChecked(*maps, {}, {}, [&](auto key, auto value) {
+      f(std::string(View(key)), value.ok() ? DecodeMapInfo(View(*value)) : absl::StatusOr<MapInfo>(value.status()));
+      return true;
+    });
+  });
+}
+
 absl::StatusOr<MapInfo> Catalog::Create(MapInfo info, uint32_t default_shards,
                                         const std::function<bool(uint64_t)>& id_in_use) {
   if (info.shards == 0) info.shards = default_shards;

@@ -38,6 +38,9 @@ inline constexpr size_t kDefaultPageSize = 100;
 class Catalog {
  public:
   static absl::StatusOr<std::unique_ptr<Catalog>> Open(const std::string& dir);
+  // An existing catalog for reading only, while no process writes it (a checker's, storage/verify.h):
+  // nothing is created or written, not even a lock file.
+  static absl::StatusOr<std::unique_ptr<Catalog>> OpenReadOnly(const std::string& dir);
 
   // InvalidArgument naming the bad field, AlreadyExists for a taken name. `default_shards` fills in info.shards when it
   // is 0. Ids for which `id_in_use` is true are skipped (the Store passes "a directory by that id exists": never hand
@@ -50,6 +53,9 @@ class Catalog {
   absl::StatusOr<MapPage> List(size_t page_size, const std::string& page_token) const;
   // NotFound when no map has that name.
   absl::Status Delete(const std::string& name);
+  // Calls f(name, its info or why it does not decode) for every record in name order, damaged ones
+  // included (List stops at the first). An LMDB error ends the walk and is returned.
+  absl::Status ForEachRecord(const std::function<void(const std::string&, const absl::StatusOr<MapInfo>&)>& f) const;
   // Puts a map back under its own id (restore from a backup). AlreadyExists for a taken name.
   absl::Status Restore(const MapInfo& info);
 

@@ -703,4 +703,12 @@ absl::StatusOr<uint64_t> MapStore::Backup(const std::string& dir) {
   return bytes;
 }
 
+VerifyReport MapStore::Verify() {
+  std::lock_guard backup(backup_mutex_);
+  VerifyOptions options;
+  options.isolate = true;
+  options.live = true;
+  return VerifyMap(dir_, info_, options);
+}
+
 }  // namespace fremen::storage

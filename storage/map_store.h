@@ -42,6 +42,7 @@
 #include "storage/shard.h"
 #include "storage/shard_workers.h"
 #include "storage/update_record.h"
+#include "storage/verify.h"
 #include "storage/wal/wal.h"
 
 namespace fremen::storage {
@@ -156,6 +157,12 @@ class MapStore {
   // A consistent copy of every shard and the map's info into `dir` (created, must be empty).
   // Returns the bytes written.
   absl::StatusOr<uint64_t> Backup(const std::string& dir);
+  // Verifies the map's files while it serves (storage/verify.h). Each shard is read in a forked
+  // child process through LMDB's reader table: LMDB allows one environment per file per process,
+  // and an abort on a damaged page ends the child, not the daemon. Checkpoints wait meanwhile (as
+  // for a backup), so that the shards and the log are read at one position and no log segment is
+  // dropped while it is read; batches go on being logged and acknowledged.
+  VerifyReport Verify();
 
  private:
   // A submitted batch. Everything that needs no shared state — classification, the log record,

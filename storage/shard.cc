@@ -8,21 +8,22 @@
 #include "storage/model/publication.h"
 #include "storage/model/record_codec.h"
 #include "storage/model/scan_update.h"
+#include "storage/shard_records.h"
 #include "storage/static_bricks.h"
 
 namespace fremen::storage {
 
 namespace {
 
-constexpr char kStaticDb[] = "static";
-constexpr char kDynamicDb[] = "dynamic";
-constexpr char kLosslessDb[] = "lossless";
-constexpr char kWideDb[] = "wide";  // state key → double spectrum body of a wide state (WideBodies)
-constexpr char kLabelsDb[] = "labels";
-constexpr char kMetaDb[] = "meta";
-constexpr char kLsnKey[] = "checkpoint_lsn";
-constexpr char kDedupKey[] = "dedup";
-constexpr char kTouchedKey[] = "touched";
+using shard_records::kDedupKey;
+using shard_records::kDynamicDb;
+using shard_records::kLabelsDb;
+using shard_records::kLosslessDb;
+using shard_records::kLsnKey;
+using shard_records::kMetaDb;
+using shard_records::kStaticDb;
+using shard_records::kTouchedKey;
+using shard_records::kWideDb;
 
 std::span<const uint8_t> Bytes(std::string_view s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
 std::string_view View(std::span<const uint8_t> b) { return {reinterpret_cast<const char*>(b.data()), b.size()}; }
@@ -52,7 +53,7 @@ absl::StatusOr<std::unique_ptr<Shard>> Shard::Open(const MapInfo& map, const mod
                                                    const std::string& dir, const LmdbOptions& options,
                                                    uint32_t widen_records_at) {
   LmdbOptions with_databases = options;
-  with_databases.databases = {kStaticDb, kDynamicDb, kLosslessDb, kWideDb, kLabelsDb, kMetaDb};
+  with_databases.databases = shard_records::AllDatabases();
   auto env = LmdbEnv::Open(dir, with_databases);
   if (!env.ok()) return env.status();
   auto shard = std::unique_ptr<Shard>(new Shard(map, settings, *std::move(env), widen_records_at));
@@ -428,12 +429,7 @@ Shard::CheckpointImage Shard::PrepareCheckpoint(uint64_t lsn, const DedupTable& 
     }
     for (uint64_t key : dirty_labels_) {
       const auto& [name, group] = labels_.at(key);
-      std::string value;
-      model::PutVarint64(&value, name.size());
-      value += name;
-      model::PutVarint64(&value, group.size());
-      value += group;
-      image.labels.emplace_back(key, std::move(value));
+      image.labels.emplace_back(key, shard_records::EncodeLabel(name, group));
     }
     image.touched = EncodeTouched();
     image.dedup = dedup.Encode();
@@ -494,8 +490,9 @@ absl::Status Shard::Load() {
     if (!meta_db.ok()) return meta_db.status();
     // An absent meta record is a shard never checkpointed; a damaged one (DataLoss) is an error.
     if (auto lsn = txn.Get(*meta_db, Bytes(kLsnKey)); lsn.ok()) {
-      if (lsn->size() != 8) return absl::DataLossError("shard meta: checkpoint_lsn is not 8 bytes");
-      std::memcpy(&checkpoint_lsn_, lsn->data(), 8);
+      auto decoded = shard_records::DecodeCheckpointLsn(*lsn);
+      if (!decoded.ok()) return decoded.status();
+      checkpoint_lsn_ = *decoded;
     } else if (!absl::IsNotFound(lsn.status())) {
       return lsn.status();
     }
@@ -581,11 +578,9 @@ absl::Status Shard::Load() {
       if (absl::Status s = DecodeTouched(*touched); !s.ok()) return s;
     }
     return scan(kLabelsDb, [&](uint64_t key, std::string_view value) -> absl::Status {
-      model::ByteReader r(value, "labels");
-      std::string name(r.Bytes(r.Varint("name length"), "name"));
-      std::string group(r.Bytes(r.Varint("group length"), "group"));
-      if (absl::Status s = r.Finish(); !s.ok()) return s;
-      labels_[key] = {std::move(name), std::move(group)};
+      auto label = shard_records::DecodeLabel(value);
+      if (!label.ok()) return label.status();
+      labels_[key] = *std::move(label);
       return absl::OkStatus();
     });
   });

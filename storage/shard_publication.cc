@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "storage/model/varint.h"
 #include "storage/shard.h"
+#include "storage/shard_records.h"
 
 namespace fremen::storage {
 
@@ -87,31 +88,21 @@ std::string Shard::EncodeTouched() const {
     if (publish_flags_[d] & kTouched) keys.push_back(slots_[slot_of_[d]].key);
   }
   std::sort(keys.begin(), keys.end());
-  std::string out;
-  model::PutVarint64(&out, keys.size());
-  uint64_t previous = 0;
-  for (uint64_t key : keys) {
-    model::PutVarint64(&out, key - previous);
-    previous = key;
-  }
-  return out;
+  return shard_records::EncodeTouched(keys);
 }
 
 absl::Status Shard::DecodeTouched(std::string_view bytes) {
   std::fill(publish_flags_.begin(), publish_flags_.end(), 0);
-  model::ByteReader r(bytes, "touched states");
-  const uint64_t count = r.Varint("count");
-  uint64_t key = 0;
-  for (uint64_t i = 0; i < count && r.ok(); ++i) {
-    key += r.Varint("key delta");
-    if (!r.ok()) break;
+  auto keys = shard_records::DecodeTouched(bytes);
+  if (!keys.ok()) return keys.status();
+  for (uint64_t key : *keys) {
     const uint32_t slot = FindSlot(key);
     if (slot == kNone || slots_[slot].dynamic == kNone) {
       return absl::DataLossError(absl::StrCat("touched states: state ", key, " is not a dynamic state of the shard"));
     }
     publish_flags_[slots_[slot].dynamic] = kTouched;
   }
-  return r.Finish();
+  return absl::OkStatus();
 }
 
 }  // namespace fremen::storage

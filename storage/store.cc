@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "storage/lmdb/lmdb_probe.h"
+#include "storage/verify.h"
 
 namespace fremen::storage {
 
@@ -180,6 +181,16 @@ absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::str
   auto backed_up = DecodeMapInfo(bytes.str());
   if (!backed_up.ok()) return backed_up.status();
   MapInfo info = *backed_up;
+  // Nothing is created from a damaged backup. Each shard is read in a child process, which LMDB
+  // may abort on a damaged page without taking the daemon down.
+  VerifyOptions verify;
+  verify.isolate = true;
+  if (const VerifyReport report = VerifyShards(dir, info, verify); !report.clean()) {
+    return absl::DataLossError(absl::StrCat("backup ", dir, " is damaged: ", FormatProblem(report.problems[0]),
+                                            report.problems.size() > 1
+                                                ? absl::StrCat(" (and ", report.problems.size() - 1, " more problems)")
+                                                : ""));
+  }
   if (!name.empty()) info.name = name;
   std::lock_guard lock(mutex_);
   auto created = catalog_->Create(info, info.shards, [this](uint64_t id) { return HasDirectory(id); });

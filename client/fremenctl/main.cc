@@ -4,6 +4,7 @@
 #include "CLI/CLI.hpp"
 #include "client/fremenctl/admin_commands.h"
 #include "client/fremenctl/bench_command.h"
+#include "client/fremenctl/check_command.h"
 #include "client/fremenctl/connection.h"
 #include "client/fremenctl/demo_command.h"
 #include "client/fremenctl/eval_command.h"
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   fremen::client::RegisterBackupCommand(app);
   fremen::client::RegisterRestoreCommand(app);
   fremen::client::RegisterStatusCommand(app);
+  fremen::client::RegisterCheckCommand(app);
   fremen::client::RegisterIngestCommand(app);
   fremen::client::RegisterRegionCommand(app);
   fremen::client::RegisterModelCommand(app);

@@ -173,6 +173,9 @@ class Client {
   absl::StatusOr<v1::Map> RestoreMap(absl::string_view directory, absl::string_view map = "",
                                      const CallOptions& call = {}) const;
   absl::StatusOr<v1::GetServerStatusResponse> GetServerStatus(const CallOptions& call = {}) const;
+  // Verifies the map's files while it serves (like fsck); problems are in the answer (clean is
+  // false), not in the status. Reads every record: give it a deadline to match the map's size.
+  absl::StatusOr<v1::CheckMapResponse> CheckMap(absl::string_view map, const CallOptions& call = {}) const;
 
  private:
   std::shared_ptr<Connection> connection_;

@@ -115,4 +115,15 @@ absl::StatusOr<v1::GetServerStatusResponse> Client::GetServerStatus(const CallOp
   return response;
 }
 
+absl::StatusOr<v1::CheckMapResponse> Client::CheckMap(absl::string_view map, const CallOptions& call) const {
+  v1::CheckMapRequest request;
+  request.set_map(std::string(map));
+  v1::CheckMapResponse response;
+  absl::Status status = connection_->CallIdempotent(call, map, [&](grpc::ClientContext& context) {
+    return connection_->admin().CheckMap(&context, request, &response);
+  });
+  if (!status.ok()) return status;
+  return response;
+}
+
 }  // namespace fremen::client

@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "absl/strings/escaping.h"
@@ -53,37 +54,45 @@ absl::Status LmdbStatus(int rc, absl::string_view what) {
 
 absl::StatusOr<MDB_dbi> LmdbTxn::Db(const std::string& name) const {
   const auto it = dbs_->find(name);
+  if (it == dbs_->end() && absent_ != nullptr && std::find(absent_->begin(), absent_->end(), name) != absent_->end()) {
+    return absl::NotFoundError(absl::StrCat("database ", name, " does not exist"));
+  }
   if (it == dbs_->end()) return absl::InvalidArgumentError(absl::StrCat("database ", name, " was not declared"));
   return it->second;
 }
 
-absl::Status LmdbEnv::OpenDatabases(const std::vector<std::string>& names) {
+absl::Status LmdbEnv::OpenDatabases(const std::vector<std::string>& names, bool read_only) {
   MDB_txn* txn;
-  int rc = mdb_txn_begin(env_, nullptr, 0, &txn);
+  int rc = mdb_txn_begin(env_, nullptr, read_only ? MDB_RDONLY : 0, &txn);
   if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin");
   for (const std::string& name : names) {
     MDB_dbi dbi;
-    rc = mdb_dbi_open(txn, name.c_str(), MDB_CREATE, &dbi);
+    rc = mdb_dbi_open(txn, name.c_str(), read_only ? 0 : MDB_CREATE, &dbi);
+    if (rc == MDB_NOTFOUND && read_only) {
+      absent_.push_back(name);
+      continue;
+    }
     if (rc != MDB_SUCCESS) {
       mdb_txn_abort(txn);
       return LmdbStatus(rc, absl::StrCat("mdb_dbi_open ", name, " in ", file_));
     }
     dbs_[name] = dbi;
   }
-  LmdbTxn wrapped(txn, &dbs_, &file_);
-  if (absl::Status format = CheckRecordFormat(wrapped); !format.ok()) {
+  LmdbTxn wrapped(txn, &dbs_, &file_, &absent_);
+  if (absl::Status format = CheckRecordFormat(wrapped, read_only); !format.ok()) {
     mdb_txn_abort(txn);
     return format;
   }
   return LmdbStatus(mdb_txn_commit(txn), "mdb_txn_commit (databases)");
 }
 
-absl::Status LmdbEnv::CheckRecordFormat(LmdbTxn& txn) {
+absl::Status LmdbEnv::CheckRecordFormat(LmdbTxn& txn, bool read_only) {
   MDB_dbi format_db;
-  if (int rc = mdb_dbi_open(txn.get(), kFormatDb, MDB_CREATE, &format_db); rc != MDB_SUCCESS) {
-    return LmdbStatus(rc, absl::StrCat("mdb_dbi_open ", kFormatDb, " in ", file_));
-  }
-  auto marker = txn.Get(format_db, Bytes(kFormatKey));
+  const int rc = mdb_dbi_open(txn.get(), kFormatDb, read_only ? 0 : MDB_CREATE, &format_db);
+  const bool unmarked = read_only && rc == MDB_NOTFOUND;
+  if (rc != MDB_SUCCESS && !unmarked) return LmdbStatus(rc, absl::StrCat("mdb_dbi_open ", kFormatDb, " in ", file_));
+  auto marker = unmarked ? absl::StatusOr<std::span<const uint8_t>>(absl::NotFoundError("no marker"))
+                         : txn.Get(format_db, Bytes(kFormatKey));
   if (marker.ok()) {
     if (marker->size() == 1 && (*marker)[0] == kLmdbRecordFormat) return absl::OkStatus();
     return absl::FailedPreconditionError(absl::StrCat(file_, " holds records of format ",
@@ -101,6 +110,7 @@ absl::Status LmdbEnv::CheckRecordFormat(LmdbTxn& txn) {
                                                         kLmdbRecordFormat, "); this build cannot read them"));
     }
   }
+  if (read_only) return absl::OkStatus();  // empty: nothing to read, nothing to mark
   const uint8_t format = kLmdbRecordFormat;
   return txn.Put(format_db, Bytes(kFormatKey), {&format, 1});
 }
@@ -184,7 +194,7 @@ absl::StatusOr<size_t> LmdbTxn::Count(MDB_dbi dbi) const {
 }
 
 absl::StatusOr<std::unique_ptr<LmdbEnv>> LmdbEnv::Open(const std::string& dir, const LmdbOptions& options) {
-  if (mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) {
+  if (!options.read_only && mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) {
     return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", std::strerror(errno)));
   }
   MDB_env* env;
@@ -196,6 +206,7 @@ absl::StatusOr<std::unique_ptr<LmdbEnv>> LmdbEnv::Open(const std::string& dir, c
   // NOTLS: read transactions are not tied to a thread (handlers may hop threads). NORDAHEAD: the
   // access pattern is random lookups or full scans into memory, where readahead only pollutes.
   unsigned flags = MDB_NOTLS | MDB_NORDAHEAD | (options.no_sync ? MDB_NOSYNC : 0);
+  if (options.read_only) flags |= MDB_RDONLY | (options.no_lock ? MDB_NOLOCK : 0);
   rc = mdb_env_open(env, dir.c_str(), flags, 0640);
   if (rc != MDB_SUCCESS) {
     mdb_env_close(env);
@@ -204,9 +215,10 @@ absl::StatusOr<std::unique_ptr<LmdbEnv>> LmdbEnv::Open(const std::string& dir, c
   MDB_envinfo info;
   mdb_env_info(env, &info);
   auto result = std::unique_ptr<LmdbEnv>(new LmdbEnv(env, dir, info.me_mapsize));
+  result->read_only_ = options.read_only;
   int dead = 0;
-  mdb_reader_check(env, &dead);  // slots of processes killed while reading
-  if (absl::Status s = result->OpenDatabases(options.databases); !s.ok()) return s;
+  if (!options.no_lock) mdb_reader_check(env, &dead);  // slots of processes killed while reading
+  if (absl::Status s = result->OpenDatabases(options.databases, options.read_only); !s.ok()) return s;
   return result;
 }
 
@@ -233,6 +245,7 @@ absl::Status LmdbEnv::Grow() {
 
 absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {
   std::lock_guard writer(writer_);
+  if (read_only_) return absl::FailedPreconditionError(absl::StrCat(dir_, " is open for reading only"));
   if (absl::Status latched = health(); !latched.ok()) return latched;
   for (;;) {
     int rc;
@@ -267,7 +280,7 @@ absl::Status LmdbEnv::Read(const std::function<absl::Status(LmdbTxn&)>& f) const
   MDB_txn* txn;
   const int rc = mdb_txn_begin(env_, nullptr, MDB_RDONLY, &txn);
   if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin (read)");
-  LmdbTxn wrapped(txn, &dbs_, &file_);
+  LmdbTxn wrapped(txn, &dbs_, &file_, &absent_);
   absl::Status status = f(wrapped);
   mdb_txn_abort(txn);
   return status;

@@ -58,6 +58,13 @@ struct LmdbOptions {
   // The named databases used in this environment. They are created (when missing) and their
   // handles opened once, at Open: LMDB forbids opening handles in concurrent transactions.
   std::vector<std::string> databases;
+  // Open for reading only (MDB_RDONLY): the directory is not created, Write fails, and a declared
+  // database the file does not hold is NotFound from LmdbTxn::Db. For checkers (storage/verify.h).
+  // Default: false.
+  bool read_only = false;
+  // With read_only: no lock file is used or created (MDB_NOLOCK), so a backup directory is left
+  // exactly as it is. Only when no process writes the file meanwhile. Default: false.
+  bool no_lock = false;
 };
 
 // A byte view of an LMDB value, valid until its transaction ends.
@@ -73,11 +80,15 @@ inline constexpr uint8_t kLmdbRecordFormat = 1;
 
 class LmdbTxn {
  public:
-  // `file` names the environment's data file in errors.
-  LmdbTxn(MDB_txn* txn, const DbHandles* dbs, const std::string* file) : txn_(txn), dbs_(dbs), file_(file) {}
+  // `file` names the environment's data file in errors; `absent`: the declared databases a
+  // read-only environment does not hold.
+  LmdbTxn(MDB_txn* txn, const DbHandles* dbs, const std::string* file,
+          const std::vector<std::string>* absent = nullptr)
+      : txn_(txn), dbs_(dbs), file_(file), absent_(absent) {}
   MDB_txn* get() const { return txn_; }
 
-  // A database declared in LmdbOptions::databases; InvalidArgument for an undeclared name.
+  // A database declared in LmdbOptions::databases; InvalidArgument for an undeclared name, NotFound
+  // for one a read-only environment does not hold.
   absl::StatusOr<MDB_dbi> Db(const std::string& name) const;
   // Stores value with its checksum. `flags` as mdb_put's (MDB_NOOVERWRITE); MDB_RESERVE is implied.
   absl::Status Put(MDB_dbi dbi, std::span<const uint8_t> key, std::span<const uint8_t> value, unsigned flags = 0);
@@ -110,6 +121,7 @@ class LmdbTxn {
   MDB_txn* txn_;
   const DbHandles* dbs_;
   const std::string* file_;
+  const std::vector<std::string>* absent_;
   bool map_full_ = false;
 };
 
@@ -147,9 +159,10 @@ class LmdbEnv {
   LmdbEnv(MDB_env* env, std::string dir, size_t map_size)
       : env_(env), dir_(std::move(dir)), file_(dir_ + "/data.mdb"), map_size_(map_size) {}
   absl::Status Grow();
-  absl::Status OpenDatabases(const std::vector<std::string>& names);
-  // Writes the record format marker into a new environment; refuses one of another format.
-  absl::Status CheckRecordFormat(LmdbTxn& txn);
+  absl::Status OpenDatabases(const std::vector<std::string>& names, bool read_only);
+  // Writes the record format marker into a new environment (a writable one); refuses one of
+  // another format.
+  absl::Status CheckRecordFormat(LmdbTxn& txn, bool read_only);
   void Latch(const absl::Status& status);
 
   MDB_env* env_;
@@ -161,6 +174,8 @@ class LmdbEnv {
   mutable std::mutex latch_mutex_;
   absl::Status latched_;
   DbHandles dbs_;  // written once, at Open
+  std::vector<std::string> absent_;  // declared databases a read-only file does not hold
+  bool read_only_ = false;
 };
 
 }  // namespace fremen::storage

@@ -1,0 +1,239 @@
+// End-to-end tests of the operators' checks (issue 11): `fremenctl check MAP` (AdminService.CheckMap)
+// against a serving fremend, `fremend --verify` against a stopped data directory, and the
+// verification of a backup before `fremenctl restore` creates anything. Damage is done to the
+// files themselves, as a disk would: bytes flipped in a log segment, a page of a shard zeroed.
+#include <fcntl.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "client/lib/client.h"
+#include "fremen/v1/admin.grpc.pb.h"
+#include "tests/fremend_fixture.h"
+
+namespace fremen::testing {
+namespace {
+
+namespace fs = std::filesystem;
+using ::fremen::client::Client;
+using ::fremen::client::ScanBuilder;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+constexpr double kStart = 1699920000;
+
+struct Result {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Runs `binary args` to completion; stdout and stderr apart.
+Result RunBinary(const std::string& binary, const std::string& args, const std::string& err_path,
+                 const std::string& env = "") {
+  const std::string command = absl::StrCat(env, " '", binary, "' ", args, " 2>'", err_path, "'");
+  Result result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[4096];
+  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) result.out.append(buffer, n);
+  const int status = pclose(pipe);
+  if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
+  result.err = ReadAll(err_path);
+  return result;
+}
+
+void WriteAt(const std::string& path, uint64_t offset, const std::string& bytes) {
+  const int fd = open(path.c_str(), O_WRONLY);
+  ASSERT_GE(fd, 0) << path;
+  ASSERT_EQ(pwrite(fd, bytes.data(), bytes.size(), static_cast<off_t>(offset)), static_cast<ssize_t>(bytes.size()));
+  close(fd);
+}
+
+// Zeroes the page in the middle of an LMDB file (4 KiB pages).
+void ZeroMiddlePage(const std::string& path) {
+  const uint64_t pages = fs::file_size(path) / 4096;
+  ASSERT_GT(pages, 16u) << path;
+  WriteAt(path, pages / 2 * 4096, std::string(4096, '\0'));
+}
+
+class CheckTest : public DaemonTest {
+ protected:
+  void SetUp() override { Start(); }
+
+  void Start(const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> args = {"--backup-dir", dir_.Path("backups"), "--shards", "1"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    StartDaemon(args);
+    if (HasFatalFailure()) return;
+    client::ConnectionOptions options;
+    options.address = daemon_->address();
+    client_.emplace(*Client::Connect(options));
+    admin_ = v1::AdminService::NewStub(daemon_->NewChannel());
+  }
+
+  Result Fremenctl(const std::string& args) {
+    return RunBinary(FREMENCTL_BINARY, args, dir_.Path("stderr"),
+                     absl::StrCat("FREMEN_ADDRESS='", daemon_->address(), "'"));
+  }
+  Result Verify() {
+    return RunBinary(FREMEND_BINARY, absl::StrCat("--data-dir '", data_dir(), "' --verify"), dir_.Path("stderr"));
+  }
+
+  // A grid of nx × ny cells, every one changed (`scans` scans of alternating patches), so that its
+  // shard holds many LMDB pages.
+  void MakeGrid(const std::string& map, uint32_t nx, uint32_t ny, int scans) {
+    v1::Map m;
+    m.set_name(map);
+    m.set_kind(v1::MAP_KIND_GRID);
+    m.mutable_grid()->set_resolution(0.1);
+    m.mutable_grid()->mutable_size()->set_x(nx);
+    m.mutable_grid()->mutable_size()->set_y(ny);
+    ASSERT_TRUE(client_->CreateMap(m).ok());
+    auto session = client_->OpenIngest(map);
+    ASSERT_TRUE(session.ok()) << session.status();
+    for (int i = 0; i < scans; ++i) {
+      ScanBuilder scan(kStart + i * 3600.0);
+      scan.SetPatchBytes({0, 0, 0}, {nx, ny, 1}, std::string(uint64_t{nx} * ny, i % 2 ? '\xff' : '\0'));
+      ASSERT_TRUE((*session)->Send(*scan.Build()).ok());
+    }
+    ASSERT_TRUE((*session)->Close(absl::Seconds(120)).ok());
+  }
+
+  // The directory of a map of the (stopped) daemon's data directory: the only one under maps/.
+  std::string OnlyMapDir() const {
+    std::vector<fs::path> dirs;
+    for (const auto& e : fs::directory_iterator(data_dir() + "/maps")) dirs.push_back(e.path());
+    EXPECT_EQ(dirs.size(), 1u);
+    return dirs.empty() ? "" : dirs.front().string();
+  }
+
+  std::optional<Client> client_;
+  std::unique_ptr<v1::AdminService::Stub> admin_;
+};
+
+TEST_F(CheckTest, FremenctlCheckOfAHealthyMapExitsZeroWithASummary) {
+  MakeGrid("lab", 64, 32, 6);
+  const Result r = Fremenctl("check lab");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_THAT(r.out, HasSubstr("map lab: 1 shards, "));
+  EXPECT_THAT(r.out, HasSubstr("log 1 segments, 6 records, LSN 1..6"));
+  EXPECT_THAT(r.out, HasSubstr(": clean\n"));
+  // The map still serves and takes writes after the check.
+  auto session = client_->OpenIngest("lab");
+  ASSERT_TRUE(session.ok());
+  ASSERT_TRUE((*session)->Send(*ScanBuilder(kStart + 7 * 3600.0).AddCell({1, 1, 0}, 1.0f).Build()).ok());
+  ASSERT_TRUE((*session)->Close(absl::Seconds(30)).ok());
+  const Result json = Fremenctl("check --map lab --json");
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  EXPECT_THAT(json.out, HasSubstr("\"clean\":true"));
+  EXPECT_THAT(json.out, HasSubstr("\"last_lsn\":\"7\""));
+}
+
+TEST_F(CheckTest, CheckMapNamesTheFieldOfBadInput) {
+  v1::CheckMapRequest request;
+  v1::CheckMapResponse response;
+  grpc::Status status = admin_->CheckMap(CallContext().get(), request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("map"));
+  request.set_map("no-such-map");
+  status = admin_->CheckMap(CallContext().get(), request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(status.error_message(), HasSubstr("no-such-map"));
+  const Result r = Fremenctl("check no-such-map");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("no-such-map"));
+}
+
+TEST_F(CheckTest, AReadTokenIsEnoughToCheck) {
+  StopDaemon();
+  Start({"--tokens-file", dir_.Write("tokens", "read:reader-token\nwrite:writer-token\n")});
+  v1::CheckMapRequest request;
+  request.set_map("nothing");
+  v1::CheckMapResponse response;
+  EXPECT_EQ(admin_->CheckMap(CallContext().get(), request, &response).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  // Past authorization with the read token: the map is looked up (and does not exist).
+  EXPECT_EQ(
+      admin_->CheckMap(CallContext({{"authorization", "Bearer reader-token"}}).get(), request, &response).error_code(),
+      grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(CheckTest, FremendVerifyOfAStoppedDataDirectory) {
+  MakeGrid("lab", 64, 32, 6);
+  // Refused while the daemon holds the data directory.
+  const Result busy = Verify();
+  EXPECT_EQ(busy.exit_code, 1);
+  EXPECT_THAT(busy.err, HasSubstr("in use by another fremend"));
+  StopDaemon();
+
+  const Result clean = Verify();
+  ASSERT_EQ(clean.exit_code, 0) << clean.out << clean.err;
+  EXPECT_THAT(clean.out, HasSubstr("map lab: clean"));
+  EXPECT_THAT(clean.out, HasSubstr("summary: 1 maps verified, 0 with problems"));
+
+  // A record in the middle of the log damaged: the report names the segment.
+  std::vector<fs::path> segments;
+  for (const auto& e : fs::directory_iterator(OnlyMapDir() + "/wal")) segments.push_back(e.path());
+  ASSERT_EQ(segments.size(), 1u);
+  const std::string segment = segments.front().string();
+  const uint64_t size = fs::file_size(segment);
+  std::string byte = ReadAll(segment).substr(size / 2, 1);
+  byte[0] ^= 0x40;
+  WriteAt(segment, size / 2, byte);
+  const Result damaged = Verify();
+  EXPECT_EQ(damaged.exit_code, 1) << damaged.out << damaged.err;
+  EXPECT_THAT(damaged.out, HasSubstr(absl::StrCat("map lab: wal/", segments.front().filename().string(), ": byte ")));
+  EXPECT_THAT(damaged.out, HasSubstr("summary: 1 maps verified, 1 with problems"));
+
+  // A zeroed page of the shard (LMDB aborts on it): named too, and the check goes on.
+  ZeroMiddlePage(OnlyMapDir() + "/shard-0/data.mdb");
+  const Result zeroed = Verify();
+  EXPECT_EQ(zeroed.exit_code, 1);
+  EXPECT_THAT(zeroed.out, HasSubstr("map lab: shard-0/data.mdb: "));
+  EXPECT_THAT(zeroed.out, HasSubstr("summary: 1 maps verified"));
+  EXPECT_TRUE(fs::exists(segment));  // nothing was removed or cut
+  EXPECT_EQ(fs::file_size(segment), size);
+}
+
+TEST_F(CheckTest, ARestoreOfADamagedBackupIsDataLossAndCreatesNoMap) {
+  MakeGrid("lab", 128, 64, 4);
+  Result backup = Fremenctl("backup --map lab --to copy");
+  ASSERT_EQ(backup.exit_code, 0) << backup.err;
+  ZeroMiddlePage(dir_.Path("backups") + "/copy/shard-0/data.mdb");
+
+  v1::RestoreMapRequest request;
+  request.set_map("restored");
+  request.set_directory("copy");
+  v1::RestoreMapResponse response;
+  const grpc::Status status = admin_->RestoreMap(CallContext().get(), request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DATA_LOSS) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("shard-0/data.mdb"));
+  const Result restore = Fremenctl("restore --from copy --as restored2");
+  EXPECT_EQ(restore.exit_code, 1);
+  EXPECT_THAT(restore.err, HasSubstr("shard-0/data.mdb"));
+  const Result maps = Fremenctl("maps list");
+  ASSERT_EQ(maps.exit_code, 0) << maps.err;
+  EXPECT_THAT(maps.out, HasSubstr("lab"));
+  EXPECT_THAT(maps.out, Not(HasSubstr("restored")));
+  EXPECT_EQ(std::distance(fs::directory_iterator(data_dir() + "/maps"), fs::directory_iterator()), 1);
+  // The daemon still serves the map it has.
+  EXPECT_EQ(Fremenctl("check lab").exit_code, 0);
+}
+
+}  // namespace
+}  // namespace fremen::testing
