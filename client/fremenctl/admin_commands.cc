@@ -105,6 +105,12 @@ void RegisterStatusCommand(CLI::App& app) {
                   FormatTimestamp(s->next_update_time()).c_str());
     }
     std::printf("running operations: %u\n", s->running_operations());
+    for (const v1::MapFault& fault : s->failed_maps()) {
+      std::printf("failed map %s: %s\n", fault.map().c_str(), fault.error().c_str());
+    }
+    for (const std::string& dir : s->unknown_directories()) {
+      std::printf("unknown directory (no catalog record names it; left for an operator): %s\n", dir.c_str());
+    }
     for (const v1::Operation& op : s->last_updates()) {
       std::printf("last update of %s: %s, %s\n", op.map().c_str(), FormatTimestamp(op.end_time()).c_str(),
                   op.error().code() == 0 ? absl::StrCat(op.update().states_published(), " states published").c_str()
