@@ -17,6 +17,13 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:detect_stack
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/tsan.supp}
 
+# Under TSan, the tests that run a real gRPC server (IngestStreamTest) are left out: Debian's gRPC
+# is not built with TSan, so every handoff through its completion queues is reported as a race
+# (scripts/tsan.supp holds the ones inside its libraries; those inlined from its headers remain).
+if [ "$sanitizer" = thread ]; then
+  export GTEST_FILTER=${GTEST_FILTER:--IngestStreamTest.*}
+fi
+
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
 failed=0
