@@ -9,7 +9,8 @@ JOBS ?= $(shell nproc)
 
 ARGS ?=
 
-.PHONY: all deps configure build run demo-eval test bench asan tsan clean
+.PHONY: all deps configure build run demo-eval test bench asan tsan sanitize-ci asan-ci tsan-ci fuzz fuzz-smoke \
+        clean
 
 all: build
 
@@ -47,5 +48,28 @@ tsan: deps
 	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFREMEN_SANITIZE=thread >/dev/null
 	@cmake --build build-tsan -j$(JOBS) && cd build-tsan && ctest --output-on-failure -j$(JOBS)
 
+# CI's sanitizer step: only the storage and server unit suites, each under ASan+UBSan and under
+# TSan (a whole build of everything per sanitizer would not fit CI's time).
+SANITIZE_TESTS ?= fremen_storage_test fremen_server_test
+
+sanitize-ci: asan-ci tsan-ci
+
+asan-ci: deps
+	@bash scripts/sanitize-ci.sh address build-asan $(JOBS) $(SANITIZE_TESTS)
+
+tsan-ci: deps
+	@bash scripts/sanitize-ci.sh thread build-tsan $(JOBS) $(SANITIZE_TESTS)
+
+# libFuzzer targets (fuzz/README.md), built with clang in build-fuzz/; each runs FUZZ_SECONDS.
+FUZZ_SECONDS ?= 60
+
+fuzz:
+	@bash scripts/install-deps.sh fuzz
+	@bash fuzz/run.sh build-fuzz $(FUZZ_SECONDS) $(JOBS)
+
+fuzz-smoke:
+	@bash scripts/install-deps.sh fuzz
+	@bash fuzz/run.sh build-fuzz 10 $(JOBS)
+
 clean:
-	@rm -rf $(BUILD) build-asan build-tsan
+	@rm -rf $(BUILD) build-asan build-tsan build-fuzz

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages fremen builds and tests with, when any is missing.
 # Idempotent: does nothing (and needs no network) when everything is already there.
+#   scripts/install-deps.sh        what the build and `make test` need
+#   scripts/install-deps.sh fuzz   also clang and its libFuzzer runtime (`make fuzz`, fuzz/README.md)
 set -euo pipefail
 
 packages=(
@@ -11,6 +13,9 @@ packages=(
   python3-grpcio python3-protobuf python3-numpy
   openssl  # the tests make their TLS certificates with it
 )
+if [ "${1:-}" = fuzz ]; then
+  packages+=(clang-14 libclang-rt-14-dev)  # libclang_rt.fuzzer, asan and ubsan for clang
+fi
 
 missing=()
 for p in "${packages[@]}"; do

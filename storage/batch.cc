@@ -139,7 +139,8 @@ absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes) {
   batch.time = r.Double("time");
   const uint64_t key_count = r.Varint("key count");
   // Each key takes at least one byte and its value four: a count beyond that is corruption.
-  if (r.ok() && key_count * 5 > r.remaining()) r.Fail("key count", "more than the bytes left");
+  // (Divided, not multiplied: a count near 2^64 / 5 would wrap round to a small product.)
+  if (r.ok() && key_count > r.remaining() / 5) r.Fail("key count", "more than the bytes left");
   batch.keys.resize(r.ok() ? key_count : 0);
   uint64_t previous = 0;
   for (uint64_t& key : batch.keys) {
@@ -156,7 +157,8 @@ absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes) {
     s = static_cast<uint32_t>(v);
     cells *= s;
   }
-  if (r.ok() && cells * 4 > r.remaining()) r.Fail("patch.size", "more cells than the bytes left");
+  // Three sides up to 2^21 + 1 make up to 2^63 cells, whose 4 bytes each would wrap a uint64_t.
+  if (r.ok() && cells > r.remaining() / 4) r.Fail("patch.size", "more cells than the bytes left");
   batch.patch.values.resize(r.ok() ? cells : 0);
   for (float& v : batch.patch.values) v = r.Float("patch.value");
   const uint64_t label_count = r.Varint("label count");

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "storage/cell_key.h"
+#include "storage/model/varint.h"
 
 namespace fremen::storage {
 namespace {
@@ -91,6 +92,32 @@ TEST(BatchTest, DamagedBytesAreDataLossNeverACrash) {
     for (int flips = 0; flips < 3; ++flips) bytes[rng() % bytes.size()] ^= static_cast<char>(1 << (rng() % 8));
     (void)DecodeBatch(bytes);  // must not crash or over-allocate (ASan build)
   }
+}
+
+// Found with fuzz/batch_fuzz.cc (which aborts on these inputs without the fix): counts whose byte
+// sizes wrap a uint64_t passed the "more than the bytes left" checks, and the decoder then tried to
+// allocate up to 2^63 elements (std::length_error, the process ends).
+TEST(BatchTest, CountsWhoseSizeWrapsAreDataLossNotAHugeAllocation) {
+  ObservationBatch empty;
+  empty.time = 1.7e9;
+  const std::string good = EncodeBatch(empty);
+  // version, writer, sequence, time (8 bytes): the key count follows at byte 11.
+  const std::string head = good.substr(0, 11);
+  std::string wrapping_keys = head;
+  model::PutVarint64(&wrapping_keys, 0x3333333333333334);  // × 5 = 2^64 + 4
+  wrapping_keys += std::string(16, '\0');
+  auto keys = DecodeBatch(wrapping_keys);
+  EXPECT_TRUE(absl::IsDataLoss(keys.status())) << keys.status();
+  EXPECT_NE(keys.status().message().find("key count"), std::string::npos) << keys.status();
+
+  std::string wrapping_patch = head;
+  model::PutVarint64(&wrapping_patch, 0);                                     // no keys
+  for (int a = 0; a < 3; ++a) model::PutVarint64(&wrapping_patch, 0);         // patch origin
+  for (int a = 0; a < 3; ++a) model::PutVarint64(&wrapping_patch, 1u << 21);  // 2^63 cells, × 4 = 0 mod 2^64
+  wrapping_patch += std::string(16, '\0');
+  auto patch = DecodeBatch(wrapping_patch);
+  EXPECT_TRUE(absl::IsDataLoss(patch.status())) << patch.status();
+  EXPECT_NE(patch.status().message().find("patch.size"), std::string::npos) << patch.status();
 }
 
 }  // namespace
