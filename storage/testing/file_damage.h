@@ -26,6 +26,14 @@ inline void WriteWholeFile(const std::string& path, std::string_view bytes) {
   ASSERT_TRUE(out.good()) << "cannot write " << path;
 }
 
+// Writes `bytes` over the file's bytes from `offset` on (a stray write, a flipped run).
+inline void OverwriteBytes(const std::string& path, uint64_t offset, std::string_view bytes) {
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekp(static_cast<std::streamoff>(offset));
+  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_TRUE(f.good()) << "cannot write " << path;
+}
+
 // Offset of the only occurrence of `needle` in `bytes`; npos when absent or not unique (a test that damages "the
 // record" must know it hit that record and nothing else).
 inline size_t FindUnique(std::string_view bytes, std::span<const uint8_t> needle) {

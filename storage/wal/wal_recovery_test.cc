@@ -8,6 +8,7 @@
 
 #include "storage/map_store.h"
 #include "storage/testing/crash_image.h"
+#include "storage/testing/file_damage.h"
 #include "storage/testing/scans.h"
 #include "storage/testing/temp_dir.h"
 
@@ -23,16 +24,8 @@ std::string OnlySegment(const std::string& map_dir) {
   return segments.empty() ? "" : segments.front();
 }
 
-std::string Contents(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void Overwrite(const std::string& path, uint64_t offset, const std::string& bytes) {
-  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
-  f.seekp(static_cast<std::streamoff>(offset));
-  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
+using testing::OverwriteBytes;
+using testing::ReadWholeFile;
 
 StoreOptions NoCheckpointsUntilClose() {
   StoreOptions options;
@@ -53,8 +46,8 @@ TEST(WalRecoveryTest, Issue11ACorruptRecordAfterAcknowledgedBatchesFailsTheMapAn
   }
   const std::string segment = OnlySegment(image.path());
   const uint64_t size = std::filesystem::file_size(segment);
-  Overwrite(segment, size / 2, std::string(16, '\xa5'));
-  const std::string damaged = Contents(segment);
+  OverwriteBytes(segment, size / 2, std::string(16, '\xa5'));
+  const std::string damaged = ReadWholeFile(segment);
   auto reopened = MapStore::Open(map, image.path(), {});
   ASSERT_FALSE(reopened.ok());
   EXPECT_TRUE(absl::IsDataLoss(reopened.status())) << reopened.status();
@@ -62,7 +55,7 @@ TEST(WalRecoveryTest, Issue11ACorruptRecordAfterAcknowledgedBatchesFailsTheMapAn
   EXPECT_NE(message.find(segment), std::string::npos) << message;
   EXPECT_NE(message.find("byte "), std::string::npos) << message;
   EXPECT_NE(message.find("LSN "), std::string::npos) << message;
-  EXPECT_EQ(Contents(segment), damaged) << "nothing may be cut";
+  EXPECT_EQ(ReadWholeFile(segment), damaged) << "nothing may be cut";
   EXPECT_EQ(OnlySegment(image.path()), segment);
 }
 
@@ -79,7 +72,7 @@ TEST(WalRecoveryTest, Issue11RecordsWrittenAfterARecoveryNeverFallBelowTheCheckp
   // Bit rot in the last record, with nothing after it: judged a torn tail and cut, so that the log
   // now ends below the checkpoint.
   const std::string segment = OnlySegment(dir.path());
-  Overwrite(segment, std::filesystem::file_size(segment) - 2, "\x01\x02");
+  OverwriteBytes(segment, std::filesystem::file_size(segment) - 2, "\x01\x02");
   std::mutex warnings_mutex;
   std::vector<std::string> warnings;
   StoreOptions options = NoCheckpointsUntilClose();

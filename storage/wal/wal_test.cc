@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "absl/strings/str_cat.h"
+#include "storage/testing/file_damage.h"
 #include "storage/testing/temp_dir.h"
 
 namespace fremen::storage {
@@ -157,16 +158,8 @@ std::vector<std::string> Segments(const std::string& dir) {
   return segments;
 }
 
-std::string Contents(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void Overwrite(const std::string& path, uint64_t offset, const std::string& bytes) {
-  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
-  f.seekp(static_cast<std::streamoff>(offset));
-  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
+using testing::OverwriteBytes;
+using testing::ReadWholeFile;
 
 // Writes records 1..n, each synced, into one segment.
 void WriteRecords(const std::string& dir, uint64_t n) {
@@ -186,8 +179,8 @@ TEST(WalTest, CorruptionIsNotATornTailAMidSegmentFlipIsDataLossAndNothingIsCut) 
   const std::string segment = Segments(dir.path()).front();
   uint64_t offset = 0;  // of record 20
   for (uint64_t i = 1; i < 20; ++i) offset += 16 + Payload(i).size();
-  Overwrite(segment, offset + 3, std::string(16, '\x5a'));  // 16 bytes flipped in its header and payload
-  const std::string damaged = Contents(segment);
+  OverwriteBytes(segment, offset + 3, std::string(16, '\x5a'));  // 16 bytes flipped in its header and payload
+  const std::string damaged = ReadWholeFile(segment);
   auto replay = ReplayWal(dir.path(), 0, [](uint64_t, auto) { return absl::OkStatus(); });
   ASSERT_FALSE(replay.ok());
   EXPECT_TRUE(absl::IsDataLoss(replay.status())) << replay.status();
@@ -199,7 +192,7 @@ TEST(WalTest, CorruptionIsNotATornTailAMidSegmentFlipIsDataLossAndNothingIsCut) 
   auto writer = WalWriter::Open(dir.path(), {});
   ASSERT_FALSE(writer.ok());
   EXPECT_TRUE(absl::IsDataLoss(writer.status())) << writer.status();
-  EXPECT_EQ(Contents(segment), damaged);
+  EXPECT_EQ(ReadWholeFile(segment), damaged);
   EXPECT_EQ(Segments(dir.path()).size(), 1u);
 }
 
@@ -209,7 +202,7 @@ TEST(WalTest, AnIntactRecordOutOfSequenceIsCorruption) {
   testing::TempDir other;
   WriteRecords(other.path(), 5);
   // Record 5 of another log appended: intact, but LSN 5 where 4 is due.
-  const std::string foreign = Contents(Segments(other.path()).front());
+  const std::string foreign = ReadWholeFile(Segments(other.path()).front());
   uint64_t offset = 0;
   for (uint64_t i = 1; i < 5; ++i) offset += 16 + Payload(i).size();
   std::ofstream(Segments(dir.path()).front(), std::ios::binary | std::ios::app) << foreign.substr(offset);
@@ -230,7 +223,7 @@ TEST(WalTest, ALastRecordWithABadCrcOrZerosAtTheEndIsATornTail) {
     if (zeros) {
       std::filesystem::resize_file(segment, size + 4096);
     } else {
-      Overwrite(segment, size - 2, "\x01\x02");  // in the last record's payload
+      OverwriteBytes(segment, size - 2, "\x01\x02");  // in the last record's payload
     }
     WalReplayResult result;
     EXPECT_EQ(ReplayAll(dir.path(), 0, &result).size(), zeros ? 10u : 9u) << zeros;
