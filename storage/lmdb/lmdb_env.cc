@@ -235,7 +235,7 @@ void LmdbEnv::Latch(const absl::Status& status) {
 }
 
 absl::Status LmdbEnv::Grow() {
-  std::unique_lock lock(resize_);  // waits for every read transaction to end
+  absl::MutexLock lock(&resize_);  // waits for every read transaction to end
   const size_t bigger = map_size_ * 2;
   const int rc = mdb_env_set_mapsize(env_, bigger);
   if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_env_set_mapsize");
@@ -251,7 +251,7 @@ absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {
     int rc;
     MDB_txn* txn = nullptr;
     {
-      std::shared_lock lock(resize_);
+      absl::ReaderMutexLock lock(&resize_);
       rc = mdb_txn_begin(env_, nullptr, 0, &txn);
       if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin");
       LmdbTxn wrapped(txn, &dbs_, &file_);
@@ -276,7 +276,7 @@ absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {
 }
 
 absl::Status LmdbEnv::Read(const std::function<absl::Status(LmdbTxn&)>& f) const {
-  std::shared_lock lock(resize_);
+  absl::ReaderMutexLock lock(&resize_);
   MDB_txn* txn;
   const int rc = mdb_txn_begin(env_, nullptr, MDB_RDONLY, &txn);
   if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin (read)");
@@ -303,7 +303,7 @@ absl::Status LmdbEnv::CopyTo(const std::string& dir) const {
   if (mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) {
     return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", std::strerror(errno)));
   }
-  std::shared_lock lock(resize_);
+  absl::ReaderMutexLock lock(&resize_);
   return LmdbStatus(mdb_env_copy2(env_, dir.c_str(), MDB_CP_COMPACT), absl::StrCat("mdb_env_copy2 ", dir));
 }
 

@@ -28,7 +28,6 @@
 #include <functional>
 #include <memory>
 #include <mutex>
-#include <shared_mutex>
 #include <span>
 #include <string>
 #include <string_view>
@@ -38,6 +37,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "absl/synchronization/mutex.h"
 
 namespace fremen::storage {
 
@@ -170,7 +170,10 @@ class LmdbEnv {
   std::string file_;
   size_t map_size_;
   std::mutex writer_;                 // one write transaction at a time
-  mutable std::shared_mutex resize_;  // readers shared, map growth exclusive
+  // Read transactions (and the write transaction) shared, map growth exclusive. absl::Mutex, not
+  // std::shared_mutex: glibc's rwlock prefers readers, so a steady stream of reads starved Grow (and
+  // the writer behind it) indefinitely; absl::Mutex makes new readers wait behind a waiting Grow.
+  mutable absl::Mutex resize_;
   mutable std::mutex latch_mutex_;
   absl::Status latched_;
   DbHandles dbs_;  // written once, at Open
