@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "testing/temp_dir.h"
+
 namespace fremen::server {
 namespace {
 
@@ -32,18 +34,13 @@ Outcome Parse(std::vector<std::string> args) {
 
 class CommandLineTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string pattern = (std::filesystem::temp_directory_path() / "fremen_cli_test.XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
   std::string WriteConfig(const std::string& text) {
     const std::string path = (dir_ / "fremend.conf").string();
     std::ofstream(path) << text;
     return path;
   }
-  std::filesystem::path dir_;
+  fremen::testing::TempDir temp_;
+  const std::filesystem::path dir_{temp_.path()};
 };
 
 TEST_F(CommandLineTest, NoArgumentsRunWithTheDefaults) {

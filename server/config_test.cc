@@ -1,4 +1,5 @@
 #include "server/config.h"
+#include "testing/temp_dir.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -22,23 +23,6 @@ std::string ErrorOf(absl::string_view text) {
   return std::string(status.message());
 }
 
-// A file in a fresh temporary directory, removed with it.
-class TempFiles {
- public:
-  TempFiles() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "fremen_config_test.XXXXXX").string();
-    dir_ = mkdtemp(pattern.data());
-  }
-  ~TempFiles() { std::filesystem::remove_all(dir_); }
-  std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = (dir_ / name).string();
-    std::ofstream(path) << text;
-    return path;
-  }
-
- private:
-  std::filesystem::path dir_;
-};
 
 TEST(ConfigTest, DefaultsAreValid) {
   ServerConfig config;
@@ -139,6 +123,15 @@ TEST(ConfigTest, PerMapUpdateSchedules) {
               HasSubstr("config: update_map_schedules: map \"lab\" is given twice"));
 }
 
+TEST(ConfigTest, ScrubIntervalIsOffByDefaultAndTakesADuration) {
+  EXPECT_EQ(ServerConfig().scrub_interval, absl::ZeroDuration());
+  ServerConfig config;
+  ASSERT_TRUE(ApplyConfigText("scrub_interval = 168h\n", "test.conf", config).ok());
+  EXPECT_EQ(config.scrub_interval, absl::Hours(168));
+  EXPECT_THAT(ErrorOf("scrub_interval = -1s"), HasSubstr("config: scrub_interval: \"-1s\" is outside [0, "));
+  EXPECT_THAT(ErrorOf("scrub_interval = weekly"), HasSubstr("config: scrub_interval: \"weekly\""));
+}
+
 TEST(ConfigTest, MalformedFilesAreNamedByLine) {
   EXPECT_THAT(ErrorOf("listen"), HasSubstr("config: expected key = value, got \"listen\" (test.conf line 1)"));
   EXPECT_THAT(ErrorOf("# x\nlisten_on = 1.2.3.4:5"),
@@ -167,7 +160,7 @@ TEST(ConfigTest, TlsNeedsCertificateAndKey) {
 }
 
 TEST(ConfigTest, TlsFilesAreRead) {
-  TempFiles files;
+  fremen::testing::TempDir files;
   ServerConfig config;
   config.tls_cert_file = files.Write("cert.pem", "CERT");
   config.tls_key_file = files.Write("key.pem", "KEY");
@@ -177,7 +170,7 @@ TEST(ConfigTest, TlsFilesAreRead) {
 }
 
 TEST(ConfigTest, TokensFileAddsToInlineTokens) {
-  TempFiles files;
+  fremen::testing::TempDir files;
   ServerConfig config;
   ASSERT_TRUE(SetConfigValue("tokens", "read:inline", "--tokens", config).ok());
   config.tokens_file = files.Write("tokens", "# robots\nwrite:robot-1\n\n  read:dashboard  \n");
@@ -188,7 +181,7 @@ TEST(ConfigTest, TokensFileAddsToInlineTokens) {
 }
 
 TEST(ConfigTest, BadTokensFileIsNamedByLine) {
-  TempFiles files;
+  fremen::testing::TempDir files;
   ServerConfig config;
   config.tokens_file = files.Write("tokens", "write:robot-1\nsuper:x\n");
   EXPECT_THAT(FinishConfig(config).message(),

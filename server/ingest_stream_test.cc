@@ -17,7 +17,7 @@
 #include "storage/env/fault_injection_env.h"
 #include "storage/store.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::server {
 namespace {
@@ -78,7 +78,7 @@ class IngestStreamTest : public ::testing::Test {
 
   std::atomic<bool> disk_full_ = false;  // the log's syncs fail with ENOSPC
   storage::FaultInjectionEnv disk_;      // declared before the store, so it outlives it
-  storage::testing::TempDir dir_;
+  fremen::testing::TempDir dir_;
   std::unique_ptr<storage::Store> store_;
   CallTracker calls_;
   Authenticator auth_{{}};

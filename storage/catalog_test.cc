@@ -4,7 +4,7 @@
 
 #include <set>
 
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -17,7 +17,7 @@ MapInfo Named(const std::string& name) {
 }
 
 TEST(CatalogTest, CreateGetDeleteWithUniqueNamesAndIds) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   auto catalog = Catalog::Open(dir.path());
   ASSERT_TRUE(catalog.ok()) << catalog.status();
   auto a = (*catalog)->Create(Named("a"), 2);
@@ -44,7 +44,7 @@ TEST(CatalogTest, CreateGetDeleteWithUniqueNamesAndIds) {
 }
 
 TEST(CatalogTest, InvalidMapsAreRefusedNamingTheField) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   auto catalog = Catalog::Open(dir.path());
   ASSERT_TRUE(catalog.ok());
   MapInfo bad = Named("x");
@@ -55,7 +55,7 @@ TEST(CatalogTest, InvalidMapsAreRefusedNamingTheField) {
 }
 
 TEST(CatalogTest, ListPagesThroughEveryMapOnce) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   auto catalog = Catalog::Open(dir.path());
   ASSERT_TRUE(catalog.ok());
   for (int i = 0; i < 25; ++i) ASSERT_TRUE((*catalog)->Create(Named("map" + std::to_string(100 + i)), 1).ok());

@@ -13,7 +13,7 @@
 
 #include "storage/map_store.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -54,7 +54,7 @@ uint64_t RunAndKill(const std::string& dir, int millis) {
 }
 
 TEST(CrashTest, EveryAcknowledgedBatchSurvivesKillNineAndModelsMatchARecomputation) {
-  testing::TempDir dir, reference_dir;
+  fremen::testing::TempDir dir, reference_dir;
   const MapInfo map = testing::GridMap("crash", 48, 48, 4, 2);
   auto reference = MapStore::Open(map, reference_dir.path(), {});
   ASSERT_TRUE(reference.ok());

@@ -11,14 +11,14 @@
 #include "storage/env/fault_injection_env.h"
 #include "storage/map_store.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
 
 using testing::GridMap;
 using testing::SweepScan;
-using testing::TempDir;
+using fremen::testing::TempDir;
 
 constexpr uint64_t kWriter = 7;
 constexpr size_t kCells = 50;

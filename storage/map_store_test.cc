@@ -9,14 +9,14 @@
 #include "storage/env/fault_injection_env.h"
 #include "storage/model/phasor.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
 
 using testing::GridMap;
 using testing::SweepScan;
-using testing::TempDir;
+using fremen::testing::TempDir;
 
 std::unique_ptr<MapStore> OpenOrDie(const MapInfo& info, const std::string& dir, StoreOptions options = {}) {
   auto store = MapStore::Open(info, dir, options);
@@ -228,7 +228,7 @@ namespace fremen::storage {
 namespace {
 
 TEST(MapStoreTest, AFailedLogSyncIsNeverAcknowledgedAndLatches) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const MapInfo map = testing::GridMap("m", 16, 16, 1, 1);
   FaultInjectionEnv env;
   StoreOptions options;
@@ -261,7 +261,7 @@ namespace fremen::storage {
 namespace {
 
 TEST(MapStoreTest, RefusesWhenBehindAndCallsBackWhenThereIsRoom) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const MapInfo map = testing::GridMap("m", 64, 64, 1, 1);
   StoreOptions options;
   options.max_queued_observations = 1000;
@@ -290,7 +290,7 @@ TEST(MapStoreTest, RefusesWhenBehindAndCallsBackWhenThereIsRoom) {
 }
 
 TEST(MapStoreTest, ObservedLabelsAndPublicationProgress) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
   auto store = MapStore::Open(map, dir.path(), {});
   ASSERT_TRUE(store.ok());

@@ -15,13 +15,13 @@
 #include "storage/model/lossless_history.h"
 #include "storage/model/record_codec.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
 
 using testing::GridMap;
-using testing::TempDir;
+using fremen::testing::TempDir;
 
 constexpr double kT0 = 1.7e9;
 

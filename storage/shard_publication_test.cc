@@ -4,13 +4,13 @@
 
 #include "storage/shard.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
 
 TEST(ShardPublicationTest, PublishesIncrementalStatesInChunksOf1024PerLock) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const MapInfo info = testing::GridMap("chunks", 50, 60, 1, 1);  // 3000 cells, one shard
   auto settings = ModelSettingsOf(info);
   ASSERT_TRUE(settings.ok()) << settings.status();

@@ -17,12 +17,12 @@
 #include "storage/store.h"
 #include "storage/testing/file_damage.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
 
-using testing::TempDir;
+using fremen::testing::TempDir;
 
 constexpr uint64_t kStates = 1024;
 

@@ -8,14 +8,14 @@
 
 #include "storage/testing/file_damage.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
 
 using testing::GridMap;
 using testing::SweepScan;
-using testing::TempDir;
+using fremen::testing::TempDir;
 
 TEST(StoreTest, MapsLiveAcrossRestartsAndDeleteRemovesTheirFiles) {
   TempDir dir;

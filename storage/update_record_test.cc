@@ -4,7 +4,7 @@
 
 #include <fstream>
 
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -21,7 +21,7 @@ UpdateRecord Sample() {
 }
 
 TEST(UpdateRecordTest, RoundTripsThroughItsFile) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const std::string path = dir.path() + "/last_update";
   auto missing = ReadUpdateRecord(Env::Default(), path);
   ASSERT_TRUE(missing.ok()) << missing.status();

@@ -17,7 +17,7 @@
 #include "storage/shard_records.h"
 #include "storage/store.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -25,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 using testing::GridMap;
 using testing::SweepScan;
-using testing::TempDir;
+using fremen::testing::TempDir;
 
 std::string Describe(const VerifyReport& report) {
   std::string out;

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "testing/temp_dir.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -30,12 +32,6 @@ constexpr double kWeek = 7 * kDay;
 
 class FremenctlEvalTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "fremenctl_eval_test.XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
   // Writes `text` to a file in the temporary directory; returns its path.
   std::string Write(const std::string& name, const std::string& text) {
@@ -77,7 +73,8 @@ class FremenctlEvalTest : public ::testing::Test {
     return Run("eval --train '" + train + "' --test '" + test + "' " + extra_args);
   }
 
-  fs::path dir_;
+  fremen::testing::TempDir temp_;
+  const fs::path dir_{temp_.path()};
 };
 
 struct Row {

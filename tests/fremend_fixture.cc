@@ -64,23 +64,6 @@ int ExitCodeOf(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1
 
 }  // namespace
 
-TempDir::TempDir() {
-  std::string pattern = (fs::temp_directory_path() / "fremen_e2e.XXXXXX").string();
-  if (mkdtemp(pattern.data()) == nullptr) abort();
-  path_ = pattern;
-}
-
-TempDir::~TempDir() {
-  std::error_code ignored;
-  fs::remove_all(path_, ignored);
-}
-
-std::string TempDir::Write(const std::string& name, const std::string& text) const {
-  const std::string path = Path(name);
-  std::ofstream(path) << text;
-  return path;
-}
-
 std::string FreeLoopbackAddress() {
   // Bind port 0, read the port the kernel chose, release it. Another process could take it before
   // the daemon binds it; on a test machine that is rare, and the daemon's start then fails loudly.

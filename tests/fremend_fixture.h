@@ -24,26 +24,9 @@
 
 #include "absl/status/statusor.h"
 #include "gtest/gtest.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::testing {
-
-// A fresh directory under the system's temporary directory, removed with everything in it.
-class TempDir {
- public:
-  TempDir();
-  ~TempDir();
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  const std::string& path() const { return path_; }
-  // path()/name.
-  std::string Path(const std::string& name) const { return path_ + "/" + name; }
-  // Writes a file; returns its path.
-  std::string Write(const std::string& name, const std::string& text) const;
-
- private:
-  std::string path_;
-};
 
 struct RunResult {
   int exit_code = -1;  // -1: did not exit normally

@@ -10,6 +10,7 @@
 #include "client/formats/pgm.h"
 #include "client/formats/png_decode.h"
 #include "client/formats/region_export.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::formats {
 namespace {
@@ -19,12 +20,6 @@ using ::testing::HasSubstr;
 
 class SnapshotDirTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "fremen_snapshots_test.XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
   std::string Write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name) << text;
@@ -39,7 +34,8 @@ class SnapshotDirTest : public ::testing::Test {
                               ", 2.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n");
   }
 
-  fs::path dir_;
+  fremen::testing::TempDir temp_;
+  const fs::path dir_{temp_.path()};
 };
 
 TEST(TimeFromFileNameTest, TheNumberEndingTheName) {

@@ -22,7 +22,7 @@
 
 #include "storage/map_store.h"
 #include "storage/model/record_codec.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
   }
   const auto runs = [&only](const char* part) { return only.empty() || only == part; };
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  testing::TempDir temp;
+  fremen::testing::TempDir temp;
   if (base.empty()) base = temp.path();
 
   StoreOptions options;

@@ -26,7 +26,7 @@
 
 #include "storage/map_store.h"
 #include "storage/model/lossless_history.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--dir")) base = argv[i + 1];
   }
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  testing::TempDir temp;
+  fremen::testing::TempDir temp;
   if (base.empty()) base = temp.path();
   constexpr double kStates = double{kSide} * kSide;
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -18,7 +18,7 @@ bool Listed(Env& env, const std::string& dir, const std::string& name) {
 }
 
 TEST(FaultInjectionEnvTest, APowerCutKeepsWhatWasSyncedAndNothingElse) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const std::string durable = dir.path() + "/durable", fresh = dir.path() + "/fresh";
   FaultInjectionEnv env;
   auto file = env.NewWritableFile(durable);
@@ -42,7 +42,7 @@ TEST(FaultInjectionEnvTest, APowerCutKeepsWhatWasSyncedAndNothingElse) {
 }
 
 TEST(FaultInjectionEnvTest, UnlinksAndRenamesNotDirSyncedAreUndone) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const std::string a = dir.path() + "/a", b = dir.path() + "/b";
   FaultInjectionEnv env;
   ASSERT_TRUE(WriteFileAtomically(&env, a, "old a").ok());
@@ -71,7 +71,7 @@ TEST(FaultInjectionEnvTest, UnlinksAndRenamesNotDirSyncedAreUndone) {
 }
 
 TEST(FaultInjectionEnvTest, FaultsOnDemandAndCutsAfterCountedOperations) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const std::string path = dir.path() + "/f";
   FaultInjectionEnv env(7);
   auto file = env.NewWritableFile(path);

@@ -8,7 +8,7 @@
 
 #include "storage/lmdb/lmdb_env.h"
 #include "storage/testing/file_damage.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -51,7 +51,7 @@ absl::Status ReadEverything(const std::string& dir) {
 }
 
 TEST(LmdbProbeTest, HealthyEnvironmentsPassAndMissingOnesAreSkipped) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   WriteManyRecords(dir.path() + "/a");
   WriteManyRecords(dir.path() + "/b");
   EXPECT_TRUE(ProbeEnvironments({dir.path() + "/a", dir.path() + "/b", dir.path() + "/never-created"}).ok());
@@ -63,7 +63,7 @@ TEST(LmdbProbeTest, HealthyEnvironmentsPassAndMissingOnesAreSkipped) {
 // The case: a zeroed page in the middle of a data file makes LMDB abort the process that reads it. The probe's
 // child takes the abort; the caller gets DataLoss naming the file.
 TEST(LmdbProbeTest, AZeroedPageIsReportedNamingTheFileInsteadOfAborting) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const std::string good = dir.path() + "/good", bad = dir.path() + "/bad";
   WriteManyRecords(good);
   WriteManyRecords(bad);
@@ -79,7 +79,7 @@ TEST(LmdbProbeTest, AZeroedPageIsReportedNamingTheFileInsteadOfAborting) {
 }
 
 TEST(LmdbProbeTest, AnUnreadableFileIsDataLossNotAnAbort) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const std::string env_dir = dir.path() + "/garbage";
   std::filesystem::create_directories(env_dir);
   testing::WriteWholeFile(env_dir + "/data.mdb", std::string(3 * 4096, 'x'));
@@ -90,7 +90,7 @@ TEST(LmdbProbeTest, AnUnreadableFileIsDataLossNotAnAbort) {
 
 TEST(LmdbProbeTest, AWalkThatDoesNotEndIsStoppedAtTheTimeout) {
   // A zero timeout stands for a walk that never ends: the child is killed, the file reported.
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   WriteManyRecords(dir.path() + "/a");
   const absl::Status probed = ProbeEnvironments({dir.path() + "/a"}, {.timeout = absl::ZeroDuration()});
   EXPECT_TRUE(absl::IsDataLoss(probed)) << probed;

@@ -27,7 +27,7 @@
 #include "storage/env/fault_injection_env.h"
 #include "storage/map_store.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -143,7 +143,7 @@ uint64_t ExpectExactlyAPrefix(const MapStore& store, const MapInfo& map, uint64_
 }
 
 TEST(WalFaultTest, AFailedFsyncLatchesTheLog) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   FaultInjectionEnv env;
   WalOptions options;
   options.env = &env;
@@ -165,7 +165,7 @@ TEST(WalFaultTest, AFailedFsyncLatchesTheLog) {
 }
 
 TEST(WalFaultTest, DiskFullIsResourceExhaustedAndTheMapsWriteErrorSaysSo) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const MapInfo map = Map();
   FaultInjectionEnv env;
   {
@@ -191,7 +191,7 @@ TEST(WalFaultTest, DiskFullIsResourceExhaustedAndTheMapsWriteErrorSaysSo) {
 }
 
 TEST(WalFaultTest, AnIoErrorOnWriteLatchesAndNothingIsAcknowledged) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const MapInfo map = Map();
   FaultInjectionEnv env;
   auto store = MapStore::Open(map, dir.path(), FaultOptions(&env));
@@ -206,7 +206,7 @@ TEST(WalFaultTest, AnIoErrorOnWriteLatchesAndNothingIsAcknowledged) {
 }
 
 TEST(WalFaultTest, ATornWriteAtTheTailIsCutWithAWarningOnRecovery) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   const MapInfo map = Map();
   FaultInjectionEnv env(3);
   {
@@ -255,7 +255,7 @@ void PowerCutRounds(int rounds, uint64_t seed, uint64_t max_ops,
   for (int round = 0; round < rounds; ++round) {
     const std::string context = "round " + std::to_string(round);
     std::mt19937_64 rng(seed * 1000 + round);
-    testing::TempDir dir;
+    fremen::testing::TempDir dir;
     FaultInjectionEnv env(rng());
     env.set_tear_at_cut(round % 2 == 1);
     uint64_t acked = 0, submitted = 0;
@@ -305,7 +305,7 @@ TEST(WalFaultTest, PowerCutsDuringAPublicationLoseNoAcknowledgedBatch) {
 }
 
 TEST(WalFaultTest, PowerCutsDuringABackupLoseNoAcknowledgedBatch) {
-  testing::TempDir backups;
+  fremen::testing::TempDir backups;
   int backup = 0;
   uint64_t restorable = 0;
   PowerCutRounds(20, 4, 12, [&](MapStore& store, Ingest& ingest) {

@@ -10,7 +10,7 @@
 #include "storage/testing/crash_image.h"
 #include "storage/testing/file_damage.h"
 #include "storage/testing/scans.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -36,7 +36,7 @@ StoreOptions NoCheckpointsUntilClose() {
 // Before: replay took the flip for a torn tail, cut the log there and served the map without the 20
 // acknowledged batches after it.
 TEST(WalRecoveryTest, Issue11ACorruptRecordAfterAcknowledgedBatchesFailsTheMapAndCutsNothing) {
-  testing::TempDir dir, image;
+  fremen::testing::TempDir dir, image;
   const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
   {
     auto store = MapStore::Open(map, dir.path(), NoCheckpointsUntilClose());
@@ -62,7 +62,7 @@ TEST(WalRecoveryTest, Issue11ACorruptRecordAfterAcknowledgedBatchesFailsTheMapAn
 // Before: the writer resumed at the cut record's LSN, at or below the shards' checkpoint, and the
 // next recovery skipped the new records as checkpointed (20 of 30 acknowledged batches gone).
 TEST(WalRecoveryTest, Issue11RecordsWrittenAfterARecoveryNeverFallBelowTheCheckpoint) {
-  testing::TempDir dir, image;
+  fremen::testing::TempDir dir, image;
   const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
   {
     auto store = MapStore::Open(map, dir.path(), NoCheckpointsUntilClose());
@@ -101,7 +101,7 @@ TEST(WalRecoveryTest, Issue11RecordsWrittenAfterARecoveryNeverFallBelowTheCheckp
 }
 
 TEST(WalRecoveryTest, ALogRemovedAltogetherRestartsAboveTheCheckpoint) {
-  testing::TempDir dir, image;
+  fremen::testing::TempDir dir, image;
   const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
   {
     auto store = MapStore::Open(map, dir.path(), NoCheckpointsUntilClose());

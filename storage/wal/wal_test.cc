@@ -8,7 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "storage/testing/file_damage.h"
-#include "storage/testing/temp_dir.h"
+#include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
@@ -34,7 +34,7 @@ std::vector<uint64_t> ReplayAll(const std::string& dir, uint64_t after, WalRepla
 }
 
 TEST(WalTest, ReplaysWhatWasSyncedInOrderAfterAGivenLsn) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   {
     auto wal = WalWriter::Open(dir.path(), {});
     ASSERT_TRUE(wal.ok()) << wal.status();
@@ -60,7 +60,7 @@ TEST(WalTest, ReplaysWhatWasSyncedInOrderAfterAGivenLsn) {
 }
 
 TEST(WalTest, UnsyncedRecordsAreNotDurable) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   {
     auto wal = WalWriter::Open(dir.path(), {});
     ASSERT_TRUE(wal.ok());
@@ -72,7 +72,7 @@ TEST(WalTest, UnsyncedRecordsAreNotDurable) {
 }
 
 TEST(WalTest, ATornTailIsCutAndTheLogGoesOn) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   std::string segment;
   {
     auto wal = WalWriter::Open(dir.path(), {});
@@ -98,7 +98,7 @@ TEST(WalTest, ATornTailIsCutAndTheLogGoesOn) {
 }
 
 TEST(WalTest, SegmentsRollAndCheckpointedOnesAreDropped) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   WalOptions options;
   options.segment_bytes = 2000;
   auto wal = WalWriter::Open(dir.path(), options);
@@ -122,7 +122,7 @@ TEST(WalTest, SegmentsRollAndCheckpointedOnesAreDropped) {
 }
 
 TEST(WalTest, CorruptionBeforeTheTailIsDataLoss) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   WalOptions options;
   options.segment_bytes = 1000;
   {
@@ -174,7 +174,7 @@ void WriteRecords(const std::string& dir, uint64_t n) {
 // Issue 11, case 1: a bad record of the last segment was taken for a torn tail, and everything
 // after it was cut.
 TEST(WalTest, CorruptionIsNotATornTailAMidSegmentFlipIsDataLossAndNothingIsCut) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   WriteRecords(dir.path(), 40);
   const std::string segment = Segments(dir.path()).front();
   uint64_t offset = 0;  // of record 20
@@ -197,9 +197,9 @@ TEST(WalTest, CorruptionIsNotATornTailAMidSegmentFlipIsDataLossAndNothingIsCut) 
 }
 
 TEST(WalTest, AnIntactRecordOutOfSequenceIsCorruption) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   WriteRecords(dir.path(), 3);
-  testing::TempDir other;
+  fremen::testing::TempDir other;
   WriteRecords(other.path(), 5);
   // Record 5 of another log appended: intact, but LSN 5 where 4 is due.
   const std::string foreign = ReadWholeFile(Segments(other.path()).front());
@@ -216,7 +216,7 @@ TEST(WalTest, AnIntactRecordOutOfSequenceIsCorruption) {
 // last record half old bytes; nothing after it was ever acknowledged.
 TEST(WalTest, ALastRecordWithABadCrcOrZerosAtTheEndIsATornTail) {
   for (const bool zeros : {false, true}) {
-    testing::TempDir dir;
+    fremen::testing::TempDir dir;
     WriteRecords(dir.path(), 10);
     const std::string segment = Segments(dir.path()).front();
     const uint64_t size = std::filesystem::file_size(segment);
@@ -239,7 +239,7 @@ TEST(WalTest, ALastRecordWithABadCrcOrZerosAtTheEndIsATornTail) {
 // Issue 11, case 2: the writer resumed below the shards' checkpoint LSN, and a later recovery
 // skipped the new records as checkpointed.
 TEST(WalTest, TheWriterNeverGoesBelowItsLsnFloor) {
-  testing::TempDir dir;
+  fremen::testing::TempDir dir;
   WriteRecords(dir.path(), 10);
   WalOptions options;
   options.min_next_lsn = 31;  // a checkpoint at LSN 30, and the log lost its records 11..30
@@ -265,7 +265,7 @@ TEST(WalTest, TheWriterNeverGoesBelowItsLsnFloor) {
   ASSERT_TRUE(wal.ok());
   EXPECT_EQ((*wal)->Append(Payload(32)), 32u);
   // A log removed altogether starts at the floor too.
-  testing::TempDir empty;
+  fremen::testing::TempDir empty;
   options.min_next_lsn = 100;
   auto fresh = WalWriter::Open(empty.path(), options);
   ASSERT_TRUE(fresh.ok());
