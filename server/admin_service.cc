@@ -35,11 +35,6 @@ constexpr MethodSpec kCheckMap{"CheckMap", Access::kRead, /*blocking=*/true};
 
 constexpr char kOperationPrefix[] = "operations/";
 
-std::shared_ptr<spdlog::logger> Log() {
-  auto logger = spdlog::get(kDaemonLogger);
-  return logger != nullptr ? logger : spdlog::default_logger();
-}
-
 // The map a call names in its field or header, or "" when it names none (where that is allowed:
 // operations are found by name, and a restore may keep the backed-up name).
 absl::StatusOr<std::string> OptionalMapName(const grpc::ServerContextBase& context, const std::string& request_map,
@@ -56,15 +51,32 @@ absl::Status RenameRestoreFields(const absl::Status& status) {
   return absl::InvalidArgumentError(absl::StrCat("map", status.message().substr(4)));
 }
 
+void ProblemToProto(const storage::VerifyProblem& p, v1::CheckProblem& problem) {
+  problem.set_file(p.file);
+  problem.set_location(p.where);
+  problem.set_description(p.what);
+}
+
+void ScrubsToProto(const Scrubber& scrubber, v1::GetServerStatusResponse& response) {
+  if (const absl::Time next = scrubber.NextPass(); next != absl::InfiniteFuture()) {
+    TimeToProto(next, *response.mutable_next_scrub_time());
+  }
+  for (const Scrubber::Result& result : scrubber.Results()) {
+    v1::MapScrub& scrub = *response.add_map_scrubs();
+    scrub.set_map(result.map);
+    TimeToProto(result.finished, *scrub.mutable_finish_time());
+    scrub.set_duration_seconds(absl::ToDoubleSeconds(result.took));
+    scrub.set_clean(result.clean);
+    scrub.set_problem_count(result.problem_count);
+    for (const storage::VerifyProblem& p : result.problems) ProblemToProto(p, *scrub.add_problems());
+    scrub.set_records(result.records);
+  }
+}
+
 void VerifyReportToProto(const storage::VerifyReport& report, v1::CheckMapResponse& response) {
   response.set_map(report.map);
   response.set_clean(report.clean());
-  for (const storage::VerifyProblem& p : report.problems) {
-    v1::CheckProblem* problem = response.add_problems();
-    problem->set_file(p.file);
-    problem->set_location(p.where);
-    problem->set_description(p.what);
-  }
+  for (const storage::VerifyProblem& p : report.problems) ProblemToProto(p, *response.add_problems());
   for (const std::string& note : report.notes) response.add_notes(note);
   for (const storage::ShardVerifyReport& s : report.shards) {
     v1::ShardCheck* shard = response.add_shards();
@@ -224,7 +236,7 @@ absl::Status AdminServiceImpl::BackupInto(const std::string& name, const std::st
   response.set_path(dir);
   response.set_bytes(*bytes);
   response.set_duration_seconds(absl::ToDoubleSeconds(took));
-  Log()->info("backup of map {} to {}: {} bytes in {}", name, dir, *bytes, absl::FormatDuration(took));
+  DaemonLog()->info("backup of map {} to {}: {} bytes in {}", name, dir, *bytes, absl::FormatDuration(took));
   return absl::OkStatus();
 }
 
@@ -249,10 +261,10 @@ absl::Status AdminServiceImpl::Restore(const v1::RestoreMapRequest& request, con
   auto store = deps_.store->Get();
   if (!store.ok()) return store.status();
   auto info = (*store)->RestoreMap(*dir, *name);
-  if (absl::IsDataLoss(info.status())) Log()->warn("restore refused: {}", std::string(info.status().message()));
+  if (absl::IsDataLoss(info.status())) DaemonLog()->warn("restore refused: {}", std::string(info.status().message()));
   if (!info.ok()) return RenameRestoreFields(info.status());
   MapInfoToProto(*info, *response.mutable_map());
-  Log()->info("map {} restored from {}", info->name, *dir);
+  DaemonLog()->info("map {} restored from {}", info->name, *dir);
   return absl::OkStatus();
 }
 
@@ -271,9 +283,9 @@ grpc::ServerUnaryReactor* AdminServiceImpl::CheckMap(grpc::CallbackServerContext
     VerifyReportToProto(report, *response);
     response->set_duration_seconds(absl::ToDoubleSeconds(admin_.clock->Now() - start));
     if (report.clean()) {
-      Log()->info("check of map {}: clean", *name);
+      DaemonLog()->info("check of map {}: clean", *name);
     } else {
-      Log()->warn("check of map {}: {} problems, the first: {}", *name, report.problems.size(),
+      DaemonLog()->warn("check of map {}: {} problems, the first: {}", *name, report.problems.size(),
                   storage::FormatProblem(report.problems.front()));
     }
     return absl::OkStatus();
@@ -323,6 +335,7 @@ absl::Status AdminServiceImpl::FillStatus(v1::GetServerStatusResponse& response)
     failed.set_error(failed_map.status.ToString());
   }
   for (const std::string& dir : (*store)->UnknownDirectories()) response.add_unknown_directories(dir);
+  if (admin_.scrubber != nullptr) ScrubsToProto(*admin_.scrubber, response);
   for (const storage::MapInfo& info : *maps) {
     auto map = (*store)->Map(info.name);
     if (!map.ok()) continue;  // deleted meanwhile, or failed (listed above)

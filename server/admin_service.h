@@ -19,6 +19,7 @@
 #include "server/clock.h"
 #include "server/config.h"
 #include "server/operations.h"
+#include "server/scrubber.h"
 #include "server/unary_call.h"
 #include "server/update_scheduler.h"
 
@@ -28,6 +29,7 @@ namespace fremen::server {
 struct AdminDeps {
   OperationRegistry* operations = nullptr;
   const UpdateScheduler* scheduler = nullptr;  // null: no schedule
+  const Scrubber* scrubber = nullptr;          // null: no background scrub
   // The daemon's settings; backup_dir is absolute (resolved before the server starts).
   const ServerConfig* config = nullptr;
   const Clock* clock = nullptr;

@@ -235,6 +235,8 @@ std::vector<ConfigField> MakeConfigFields() {
                   }),
       {"update_map_schedules", "per-map update schedules overriding update_schedule: MAP=CRON; MAP=never",
        "SCHEDULES", SetMapSchedules, MapSchedulesValue},
+      DurationField("scrub_interval", "verify every map's files in the background this often (0: never)",
+                    &C::scrub_interval, absl::ZeroDuration(), absl::Hours(24 * 366)),
       StringField("log_level", "LEVEL", "trace, debug, info, warn, error, critical or off", &C::log_level,
                   [](absl::string_view value) -> absl::Status {
                     for (const char* level : kLogLevels) {

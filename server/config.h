@@ -86,6 +86,11 @@ struct ServerConfig {
   // Per-map overrides of update_schedule (same time zone), as "MAP=CRON; MAP=never; ...": those maps
   // follow their own schedule, or none. Default: none.
   std::vector<MapSchedule> update_map_schedules;
+  // The background scrub (server/scrubber.h): every scrub_interval, every served map's files are
+  // read and verified as CheckMap does, at the lowest CPU and I/O priority; the results are in
+  // GetServerStatus. 0 = never (the default: a scrub of a large map reads all of it, and holds
+  // back that map's checkpoints while it runs). Range [0, 366d]; e.g. "168h" for weekly.
+  absl::Duration scrub_interval = absl::ZeroDuration();
   // trace, debug, info, warn, error, critical or off.
   std::string log_level = "info";
 

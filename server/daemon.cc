@@ -14,6 +14,7 @@
 #include "server/admin_service.h"
 #include "server/ingest_service.h"
 #include "server/logging.h"
+#include "server/map_list.h"
 #include "server/map_service.h"
 #include "server/query_service.h"
 #include "server/update_job.h"
@@ -29,13 +30,6 @@ namespace fs = std::filesystem;
 // are rare; a queue this deep means the disk cannot keep up.
 constexpr size_t kMaxQueuedBlockingCalls = 256;
 
-// A named logger, or spdlog's default when logging is not set up (a daemon inside a test).
-std::shared_ptr<spdlog::logger> Logger(const char* name) {
-  auto logger = spdlog::get(name);
-  return logger != nullptr ? logger : spdlog::default_logger();
-}
-
-std::shared_ptr<spdlog::logger> Log() { return Logger(kDaemonLogger); }
 
 std::string HostOf(const std::string& listen) { return listen.substr(0, listen.rfind(':')); }
 
@@ -76,16 +70,17 @@ Daemon::Daemon(ServerConfig config)
 Daemon::~Daemon() { (void)Stop(); }
 
 absl::Status Daemon::Start() {
-  Log()->info("fremend {} starting", FREMEN_VERSION);
+  DaemonLog()->info("fremend {} starting", FREMEN_VERSION);
   if (absl::Status s = PrepareDirectories(); !s.ok()) return s;
   if (absl::Status s = PrepareUpdates(); !s.ok()) return s;
   if (absl::Status s = StartServer(); !s.ok()) return s;
   if (absl::Status s = OpenStore(); !s.ok()) return s;
   SetServing(true);
   scheduler_->Start();
+  scrubber_->Start();
   auto maps = CountMaps(*store_);
   const size_t failed = store_->FailedMaps().size();
-  Log()->info("fremend listening on {}, data in {} ({} maps{}){}", address_, config_.data_dir, maps.ok() ? *maps : 0,
+  DaemonLog()->info("fremend listening on {}, data in {} ({} maps{}){}", address_, config_.data_dir, maps.ok() ? *maps : 0,
               failed == 0 ? "" : absl::StrCat(", ", failed, " failed"), auth_.enabled() ? ", tokens required" : "");
   return absl::OkStatus();
 }
@@ -105,7 +100,7 @@ std::shared_ptr<grpc::ServerCredentials> Daemon::Credentials() const {
   const bool loopback = IsLoopback(HostOf(config_.listen));
   if (config_.tls_cert_pem.empty()) {
     if (auth_.enabled() && !loopback) {
-      Log()->warn("bearer tokens are configured without TLS on {}: they cross the network in clear text",
+      DaemonLog()->warn("bearer tokens are configured without TLS on {}: they cross the network in clear text",
                   config_.listen);
     }
     return grpc::InsecureServerCredentials();
@@ -127,7 +122,7 @@ void Daemon::AddServices(grpc::ServerBuilder& builder) {
   services_.push_back(std::make_unique<QueryServiceImpl>(deps_));
   service_names_.push_back(v1::QueryService::service_full_name());
   services_.push_back(std::make_unique<AdminServiceImpl>(
-      deps_, AdminDeps{operations_.get(), scheduler_.get(), &config_, &RealClock::Get()}));
+      deps_, AdminDeps{operations_.get(), scheduler_.get(), scrubber_.get(), &config_, &RealClock::Get()}));
   service_names_.push_back(v1::AdminService::service_full_name());
   for (const auto& service : services_) builder.RegisterService(service.get());
   service_names_.push_back("");  // the whole server
@@ -168,7 +163,7 @@ absl::Status Daemon::StartServer() {
   }
   address_ = absl::StrCat(HostOf(config_.listen), ":", port);
   SetServing(false);  // until the maps are recovered
-  Log()->info("serving gRPC on {}{} (NOT_SERVING until the maps are recovered)", address_,
+  DaemonLog()->info("serving gRPC on {}{} (NOT_SERVING until the maps are recovered)", address_,
        config_.tls_cert_pem.empty() ? "" : " with TLS");
   return absl::OkStatus();
 }
@@ -178,6 +173,17 @@ absl::Status Daemon::PrepareUpdates() {
   auto scheduler = NewStoreUpdateScheduler(config_, RealClock::Get(), &store_handle_, operations_.get());
   if (!scheduler.ok()) return scheduler.status();
   scheduler_ = *std::move(scheduler);
+  Scrubber::Options scrub;
+  scrub.interval = config_.scrub_interval;
+  scrubber_ = std::make_unique<Scrubber>(
+      scrub, RealClock::Get(), [this] { return ListAllMapNames(store_handle_); },
+      [this](const std::string& name) -> absl::StatusOr<storage::VerifyReport> {
+        auto store = store_handle_.Get();
+        if (!store.ok()) return store.status();
+        auto map = (*store)->Map(name);  // a failed map is not open, and not scrubbed
+        if (!map.ok()) return map.status();
+        return (*map)->Verify();
+      });
   return absl::OkStatus();
 }
 
@@ -185,7 +191,7 @@ absl::Status Daemon::OpenStore() {
   storage::StoreOptions options;
   options.default_shards = config_.shards;
   options.checkpoint_log_bytes = config_.checkpoint_log_mb << 20;
-  const auto store_log = Logger(kStoreLogger);
+  const auto store_log = NamedLogger(kStoreLogger);
   // What recovery repairs on its own (a torn log tail cut) is logged at warning.
   options.log_warning = [store_log](const std::string& line) { store_log->warn("{}", line); };
   store_log->info("opening {} (recovering every map)", config_.data_dir);
@@ -218,12 +224,13 @@ absl::Status Daemon::Stop() {
   if (stopped_) return absl::OkStatus();
   stopped_ = true;
   if (scheduler_ != nullptr) scheduler_->Stop();  // no new scheduled updates while stopping
+  if (scrubber_ != nullptr) scrubber_->Stop();    // after the map it is verifying
   if (server_ != nullptr) {
-    Log()->info("stopping: NOT_SERVING, no new calls, up to {} for the calls in flight",
+    DaemonLog()->info("stopping: NOT_SERVING, no new calls, up to {} for the calls in flight",
                 absl::FormatDuration(config_.shutdown_grace));
     server_->GetHealthCheckService()->Shutdown();  // every service NOT_SERVING, for good
     if (const int64_t left = calls_.Drain(config_.shutdown_grace); left > 0) {
-      Log()->warn("{} calls still in flight after {}: cancelling them", left,
+      DaemonLog()->warn("{} calls still in flight after {}: cancelling them", left,
                   absl::FormatDuration(config_.shutdown_grace));
     }
     server_->Shutdown(std::chrono::system_clock::now());
@@ -235,13 +242,13 @@ absl::Status Daemon::Stop() {
   if (store_ != nullptr) {
     closed = store_->Close();
     if (closed.ok()) {
-      Logger(kStoreLogger)->info("closed: every acknowledged write is checkpointed");
+      NamedLogger(kStoreLogger)->info("closed: every acknowledged write is checkpointed");
     } else {
-      Logger(kStoreLogger)->error("closing failed: {}", std::string(closed.message()));
+      NamedLogger(kStoreLogger)->error("closing failed: {}", std::string(closed.message()));
     }
   }
   server_.reset();
-  Log()->info("stopped");
+  DaemonLog()->info("stopped");
   return closed;
 }
 

@@ -27,6 +27,7 @@
 #include "server/operations.h"
 #include "server/store_handle.h"
 #include "server/unary_call.h"
+#include "server/scrubber.h"
 #include "server/update_scheduler.h"
 #include "storage/store.h"
 
@@ -52,7 +53,7 @@ class Daemon {
   void SetChannelArguments(grpc::ServerBuilder& builder) const;
   absl::Status StartServer();
   absl::Status OpenStore();
-  // The update jobs' registry and schedule, for the admin service.
+  // The update jobs' registry and schedule, and the background scrub, for the admin service.
   absl::Status PrepareUpdates();
   void SetServing(bool serving);
 
@@ -67,6 +68,7 @@ class Daemon {
   // Update jobs read the store: declared after it, so destroyed before it (Stop stops them first).
   std::unique_ptr<OperationRegistry> operations_;
   std::unique_ptr<UpdateScheduler> scheduler_;  // starts operations: destroyed before them
+  std::unique_ptr<Scrubber> scrubber_;           // reads the store: stopped before it closes
   std::vector<std::unique_ptr<grpc::Service>> services_;
   std::vector<std::string> service_names_;  // for health: each service, and "" for the whole server
   std::unique_ptr<grpc::Server> server_;

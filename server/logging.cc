@@ -34,4 +34,9 @@ void SetUpLogging(absl::string_view level) {
   gpr_set_log_function(LogGrpcMessage);
 }
 
+std::shared_ptr<spdlog::logger> NamedLogger(const char* name) {
+  auto logger = spdlog::get(name);
+  return logger != nullptr ? logger : spdlog::default_logger();
+}
+
 }  // namespace fremen::server

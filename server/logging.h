@@ -6,6 +6,10 @@
 // Set up once at start, before any thread; the loggers are thread-safe.
 #pragma once
 
+#include <spdlog/logger.h>
+
+#include <memory>
+
 #include "absl/strings/string_view.h"
 
 namespace fremen::server {
@@ -16,5 +20,10 @@ inline constexpr char kGrpcLogger[] = "grpc";
 
 // REQUIRES: `level` is one the config accepts (server/config.h log_level).
 void SetUpLogging(absl::string_view level);
+
+// The logger named `name` (one of the above), or spdlog's default one when SetUpLogging has not run
+// (a scheduler, a service or a daemon inside a unit test), so that code never checks for null.
+std::shared_ptr<spdlog::logger> NamedLogger(const char* name);
+inline std::shared_ptr<spdlog::logger> DaemonLog() { return NamedLogger(kDaemonLogger); }
 
 }  // namespace fremen::server

@@ -14,4 +14,15 @@ absl::StatusOr<std::vector<storage::MapInfo>> ListAllMaps(const storage::Store& 
   return maps;
 }
 
+absl::StatusOr<std::vector<std::string>> ListAllMapNames(const StoreHandle& store) {
+  auto opened = store.Get();
+  if (!opened.ok()) return opened.status();
+  auto maps = ListAllMaps(**opened);
+  if (!maps.ok()) return maps.status();
+  std::vector<std::string> names;
+  names.reserve(maps->size());
+  for (const storage::MapInfo& info : *maps) names.push_back(info.name);
+  return names;
+}
+
 }  // namespace fremen::server

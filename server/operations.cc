@@ -13,11 +13,6 @@ namespace fremen::server {
 
 namespace {
 
-std::shared_ptr<spdlog::logger> Log() {
-  auto logger = spdlog::get(kDaemonLogger);
-  return logger != nullptr ? logger : spdlog::default_logger();  // a registry inside a unit test
-}
-
 constexpr char kPublishingMessage[] =
     "publishing: the new models are one record of the map's log, applied whole and repeated whole by "
     "recovery, so the publication runs to its end";
@@ -173,7 +168,7 @@ void OperationRegistry::RunOne(uint64_t id) {
     op.view.start_time = clock_.Now();
     op.view.message = "running: reading the map's statistics";
     map = op.view.map;
-    Log()->info("update of map {} started ({}, {})", map, op.view.name, op.view.trigger);
+    DaemonLog()->info("update of map {} started ({}, {})", map, op.view.name, op.view.trigger);
   }
   JobControl control(this, id, map);
   absl::StatusOr<UpdateFigures> outcome = job_(control);
@@ -216,7 +211,7 @@ void OperationRegistry::Progress(uint64_t id, uint64_t done, uint64_t total) {
       absl::StrFormat("update of map %s: %d/%d states (%.0f%%), %.3g states/s, ~%.3g s left", view.map, done, total,
                       total > 0 ? 100.0 * done / total : 100.0, view.rate, view.eta_seconds);
   lock.unlock();
-  Log()->info("{}", line);
+  DaemonLog()->info("{}", line);
 }
 
 void OperationRegistry::FinishLocked(Operation& op, absl::StatusOr<UpdateFigures> outcome) {
@@ -231,9 +226,9 @@ void OperationRegistry::FinishLocked(Operation& op, absl::StatusOr<UpdateFigures
     view.error = outcome.status();
     view.message = std::string(outcome.status().message());
     if (absl::IsCancelled(view.error)) {
-      Log()->info("update of map {} cancelled ({}): {}", view.map, view.name, view.message);
+      DaemonLog()->info("update of map {} cancelled ({}): {}", view.map, view.name, view.message);
     } else {
-      Log()->error("update of map {} failed after {} ({}): {}", view.map, Seconds(duration), view.name, view.message);
+      DaemonLog()->error("update of map {} failed after {} ({}): {}", view.map, Seconds(duration), view.name, view.message);
     }
     return;
   }
@@ -244,7 +239,7 @@ void OperationRegistry::FinishLocked(Operation& op, absl::StatusOr<UpdateFigures
   view.message = view.cancel_requested ? "done: the cancellation came while it was publishing, which runs to its end"
                                        : "done";
   view.result = *std::move(outcome);
-  Log()->info("update of map {}: {} states in {}, ε_p {:.4g} → {:.4g}", view.map, view.result->states_published,
+  DaemonLog()->info("update of map {}: {} states in {}, ε_p {:.4g} → {:.4g}", view.map, view.result->states_published,
               Seconds(duration), view.result->prediction_error_before, view.result->prediction_error_after);
 }
 

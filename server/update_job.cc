@@ -9,15 +9,6 @@
 
 namespace fremen::server {
 
-namespace {
-
-spdlog::logger* Log() {
-  auto log = spdlog::get(kDaemonLogger);
-  return log != nullptr ? log.get() : spdlog::default_logger_raw();
-}
-
-}  // namespace
-
 UpdateJob StoreUpdateJob(const StoreHandle* store) {
   return [store](JobControl& control) -> absl::StatusOr<UpdateFigures> {
     auto opened = store->Get();
@@ -47,7 +38,7 @@ UpdateJob StoreUpdateJob(const StoreHandle* store) {
                                        figures.prediction_error_after,
                                        figures.order_histogram};
     if (absl::Status kept = (*map)->RecordUpdate(record); !kept.ok()) {
-      Log()->warn("update of map {}: its record for map statistics was not kept: {}", control.map(),
+      DaemonLog()->warn("update of map {}: its record for map statistics was not kept: {}", control.map(),
                   std::string(kept.message()));
     }
     return figures;
@@ -60,19 +51,11 @@ absl::StatusOr<std::unique_ptr<UpdateScheduler>> NewStoreUpdateScheduler(const S
                                                                          OperationRegistry* operations) {
   auto options = SchedulerOptionsFromConfig(config);
   if (!options.ok()) return options.status();
-  auto list_maps = [store]() -> absl::StatusOr<std::vector<std::string>> {
-    auto opened = store->Get();
-    if (!opened.ok()) return opened.status();
-    auto maps = ListAllMaps(**opened);
-    if (!maps.ok()) return maps.status();
-    std::vector<std::string> names;
-    for (const storage::MapInfo& info : *maps) names.push_back(info.name);
-    return names;
-  };
+  auto list_maps = [store] { return ListAllMapNames(*store); };
   auto trigger = [operations](const std::string& map) {
     // A map whose update still runs keeps that one (StartUpdate answers it): not an error.
     if (auto op = operations->StartUpdate(map, "schedule"); !op.ok()) {
-      Log()->warn("scheduled update of map {} not started: {}", map, std::string(op.status().message()));
+      DaemonLog()->warn("scheduled update of map {} not started: {}", map, std::string(op.status().message()));
     }
   };
   return std::make_unique<UpdateScheduler>(*std::move(options), clock, std::move(list_maps), std::move(trigger));

@@ -11,11 +11,6 @@ namespace fremen::server {
 
 namespace {
 
-std::shared_ptr<spdlog::logger> Log() {
-  auto logger = spdlog::get(kDaemonLogger);
-  return logger != nullptr ? logger : spdlog::default_logger();  // a scheduler inside a unit test
-}
-
 std::string Format(absl::Time t, absl::TimeZone zone) {
   return t == absl::InfiniteFuture() ? "never" : absl::FormatTime("%Y-%m-%d %H:%M:%S %Z", t, zone);
 }
@@ -34,10 +29,10 @@ UpdateScheduler::UpdateScheduler(Options options, const Clock& clock, MapLister 
 void UpdateScheduler::Start() {
   std::lock_guard lock(mutex_);
   if (entries_.empty() || thread_.joinable() || stopping_) {
-    if (entries_.empty()) Log()->info("no update schedule: updates run only on demand (RunUpdate)");
+    if (entries_.empty()) DaemonLog()->info("no update schedule: updates run only on demand (RunUpdate)");
     return;
   }
-  Log()->info("update schedule \"{}\" in {}{}; next run {}", options_.schedule ? options_.schedule->text() : "",
+  DaemonLog()->info("update schedule \"{}\" in {}{}; next run {}", options_.schedule ? options_.schedule->text() : "",
               options_.zone.name(),
               options_.overrides.empty() ? "" : absl::StrCat(", ", options_.overrides.size(), " maps with their own"),
               Format(NextRunLocked(), options_.zone));
@@ -80,7 +75,7 @@ void UpdateScheduler::Run() {
       lock.unlock();
       Fire(due);
       lock.lock();
-      Log()->info("next scheduled update {}", Format(NextRunLocked(), options_.zone));
+      DaemonLog()->info("next scheduled update {}", Format(NextRunLocked(), options_.zone));
       continue;
     }
     clock_.WaitUntil(wake_, lock, NextRunLocked());
@@ -90,7 +85,7 @@ void UpdateScheduler::Run() {
 void UpdateScheduler::Fire(const std::vector<bool>& due) {
   auto maps = list_maps_();
   if (!maps.ok()) {
-    Log()->warn("scheduled update skipped: cannot list the maps: {}", std::string(maps.status().message()));
+    DaemonLog()->warn("scheduled update skipped: cannot list the maps: {}", std::string(maps.status().message()));
     return;
   }
   const bool default_due = options_.schedule && due[0];
@@ -105,7 +100,7 @@ void UpdateScheduler::Fire(const std::vector<bool>& due) {
     trigger_(map);
     ++started;
   }
-  Log()->info("scheduled update: started for {} of {} maps", started, maps->size());
+  DaemonLog()->info("scheduled update: started for {} of {} maps", started, maps->size());
 }
 
 absl::StatusOr<UpdateScheduler::Options> SchedulerOptionsFromConfig(const ServerConfig& config) {

@@ -9,9 +9,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "absl/time/clock.h"
 #include "fremen/v1/admin.grpc.pb.h"
 #include "fremen/v1/maps.grpc.pb.h"
 #include "fremen/v1/query.grpc.pb.h"
@@ -241,6 +244,63 @@ TEST_F(FremendIntegrityTest, ACatalogBitFlipDeletesNothingAndIsReported) {
   EXPECT_THAT(daemon_->Log(), HasSubstr(alpha_dir + " is not a map of the catalog"));
   // The map's files are all there.
   EXPECT_TRUE(std::filesystem::exists(alpha_dir + "/shard-0/data.mdb"));
+}
+
+// The background scrub finds damage that nothing reads: a map is scrubbed clean, then a record's bits flip on disk
+// while the daemon serves it (its models are in memory, so queries do not notice), and the next pass reports the record
+// in GetServerStatus. Nothing is repaired or removed.
+TEST_F(FremendIntegrityTest, TheBackgroundScrubReportsARecordDamagedWhileTheDaemonServes) {
+  Connect();
+  CreateGenericMap("scrubbed");
+  ASSERT_FALSE(HasFatalFailure());
+  StopDaemon();
+  ASSERT_TRUE(WriteBatches(data_dir(), "scrubbed", Scans()).ok());
+  const std::string shard_dir = MapDirOf("scrubbed") + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::vector<std::string> values = DynamicValues(shard_dir);
+  ASSERT_EQ(values.size(), kStates);
+
+  StartDaemon({"--scrub-interval", "1s"});
+  ASSERT_FALSE(HasFatalFailure());
+  Connect();
+  // Waits (up to a minute: only a broken scrub takes that long) for a scrub of the map that `done` accepts.
+  const auto await_scrub = [&](const std::function<bool(const v1::MapScrub&)>& done) -> std::optional<v1::MapScrub> {
+    for (const absl::Time deadline = absl::Now() + absl::Minutes(1); absl::Now() < deadline;) {
+      v1::GetServerStatusResponse status;
+      const grpc::Status answered = admin_->GetServerStatus(CallContext().get(), v1::GetServerStatusRequest(), &status);
+      EXPECT_TRUE(answered.ok()) << answered.error_message();
+      EXPECT_TRUE(status.has_next_scrub_time());
+      for (const v1::MapScrub& scrub : status.map_scrubs()) {
+        if (scrub.map() == "scrubbed" && done(scrub)) return scrub;
+      }
+      absl::SleepFor(absl::Milliseconds(100));
+    }
+    return std::nullopt;
+  };
+  const std::optional<v1::MapScrub> first = await_scrub([](const v1::MapScrub&) { return true; });
+  ASSERT_TRUE(first.has_value()) << daemon_->Log();
+  EXPECT_TRUE(first->clean());
+  EXPECT_EQ(first->problem_count(), 0u);
+  EXPECT_GE(first->records(), kStates);
+
+  const std::vector<size_t> copies =
+      storage::testing::FindAll(storage::testing::ReadWholeFile(file), Bytes(values[100]));
+  ASSERT_FALSE(copies.empty());
+  for (const size_t at : copies) storage::testing::FlipBit(file, at + 40, 3);
+  const std::optional<v1::MapScrub> damaged = await_scrub([](const v1::MapScrub& scrub) { return !scrub.clean(); });
+  ASSERT_TRUE(damaged.has_value()) << daemon_->Log();
+  // The record, and what follows from its loss: the touched list names a state the shard no longer holds.
+  ASSERT_EQ(damaged->problem_count(), 2u) << damaged->DebugString();
+  ASSERT_EQ(damaged->problems_size(), 2);
+  EXPECT_EQ(damaged->problems(0).file(), "shard-0/data.mdb");
+  EXPECT_EQ(damaged->problems(0).location(), "dynamic record #101");
+  EXPECT_THAT(damaged->problems(0).description(), HasSubstr("key 0000000000000065: checksum mismatch"));
+  EXPECT_EQ(damaged->problems(1).location(), "meta record touched");
+  EXPECT_THAT(daemon_->Log(), HasSubstr("scrub of map scrubbed: 2 problems, first shard-0/data.mdb: dynamic record #101"));
+  // Still served from memory, and nothing was touched.
+  v1::PredictResponse response;
+  EXPECT_TRUE(Predict("scrubbed", &response).ok());
+  EXPECT_EQ(response.probabilities_size(), static_cast<int>(kStates));
+  EXPECT_TRUE(std::filesystem::exists(file));
 }
 
 }  // namespace

@@ -82,7 +82,7 @@ void RegisterRestoreCommand(CLI::App& app) {
 
 void RegisterStatusCommand(CLI::App& app) {
   auto json = std::make_shared<bool>(false);
-  CLI::App* status = app.add_subcommand("status", "The daemon's version, uptime, maps, schedule and last updates");
+  CLI::App* status = app.add_subcommand("status", "The daemon's version, uptime, maps, schedule, last updates and scrubs");
   status->add_flag("--json", *json, "as JSON");
   status->callback([json] {
     Client client = ConnectOrExit("status");
@@ -110,6 +110,22 @@ void RegisterStatusCommand(CLI::App& app) {
     }
     for (const std::string& dir : s->unknown_directories()) {
       std::printf("unknown directory (no catalog record names it; left for an operator): %s\n", dir.c_str());
+    }
+    if (s->has_next_scrub_time()) {
+      std::printf("background scrub: next pass %s\n", FormatTimestamp(s->next_scrub_time()).c_str());
+    }
+    for (const v1::MapScrub& scrub : s->map_scrubs()) {
+      if (scrub.clean()) {
+        std::printf("scrub of %s: %s, clean (%llu records)\n", scrub.map().c_str(),
+                    FormatTimestamp(scrub.finish_time()).c_str(), static_cast<unsigned long long>(scrub.records()));
+        continue;
+      }
+      std::printf("scrub of %s: %s, %llu PROBLEMS (fremenctl check %s lists them all)\n", scrub.map().c_str(),
+                  FormatTimestamp(scrub.finish_time()).c_str(), static_cast<unsigned long long>(scrub.problem_count()),
+                  scrub.map().c_str());
+      for (const v1::CheckProblem& p : scrub.problems()) {
+        std::printf("  %s\n", FormatCheckProblem(p).c_str());
+      }
     }
     for (const v1::Operation& op : s->last_updates()) {
       std::printf("last update of %s: %s, %s\n", op.map().c_str(), FormatTimestamp(op.end_time()).c_str(),

@@ -19,8 +19,7 @@ constexpr double kMinCheckSeconds = 600;
 
 void PrintReport(const v1::CheckMapResponse& r) {
   for (const v1::CheckProblem& p : r.problems()) {
-    std::printf("map %s: %s: %s%s\n", r.map().c_str(), p.file().c_str(),
-                p.location().empty() ? "" : absl::StrCat(p.location(), ": ").c_str(), p.description().c_str());
+    std::printf("map %s: %s\n", r.map().c_str(), FormatCheckProblem(p).c_str());
   }
   for (const std::string& note : r.notes()) std::printf("map %s: note: %s\n", r.map().c_str(), note.c_str());
   uint64_t records = 0, bytes = 0, oldest = UINT64_MAX;

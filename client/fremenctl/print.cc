@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/time/time.h"
 #include "google/protobuf/util/json_util.h"
@@ -32,6 +33,11 @@ std::string FormatBytes(uint64_t bytes) {
     ++unit;
   }
   return unit == 0 ? absl::StrFormat("%d B", bytes) : absl::StrFormat("%.1f %s", value, units[unit]);
+}
+
+std::string FormatCheckProblem(const v1::CheckProblem& problem) {
+  return absl::StrCat(problem.file(), ": ", problem.location().empty() ? "" : absl::StrCat(problem.location(), ": "),
+                      problem.description());
 }
 
 }  // namespace fremen::client

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "fremen/v1/admin.pb.h"
 #include "google/protobuf/message.h"
 #include "google/protobuf/timestamp.pb.h"
 
@@ -15,5 +16,7 @@ void PrintJson(const google::protobuf::Message& message);
 std::string FormatTimestamp(const google::protobuf::Timestamp& timestamp);
 // 1536 → "1.5 KiB".
 std::string FormatBytes(uint64_t bytes);
+// A problem found by a check or a scrub: "shard-2/data.mdb: dynamic record of state 7: checksum mismatch".
+std::string FormatCheckProblem(const v1::CheckProblem& problem);
 
 }  // namespace fremen::client
