@@ -125,7 +125,8 @@ absl::StatusOr<OperationView> AdminServiceImpl::FindOperation(const grpc::Callba
   if (!map.ok()) return map.status();
   auto op = admin_.operations->Get(name);
   if (!op.ok()) return op.status();
-  // A daemon answers only about the map a call was routed for (SPEC §6).
+  // A daemon answers only about the map a call was routed for (docs/storage.md, "Maps across
+  // daemons").
   if (!map->empty() && op->map != *map) {
     return absl::NotFoundError(absl::StrCat("no operation named \"", name, "\" on map \"", *map, "\""));
   }

@@ -1,6 +1,7 @@
 // The open map a call is about: its name from the request's field or the x-fremen-map header
 // (server/map_name.h), then the store — UNAVAILABLE while the daemon recovers, NOT_FOUND for a
-// name it does not hold (SPEC §6: a daemon says so rather than guessing).
+// name it does not hold (docs/storage.md, "Maps across daemons": a daemon says so rather than
+// guessing).
 // Pure function over thread-safe objects; thread-safe.
 #pragma once
 

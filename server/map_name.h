@@ -1,7 +1,7 @@
 // Which map a call is about. Every request names its map in a field (`map`, or `map.name` for
 // CreateMap), and clients also send it in the x-fremen-map header so that a proxy can route on it
-// (SPEC §6). The server accepts either; when both are set they must agree, so that a request a
-// proxy routed by its header cannot act on another map.
+// (docs/storage.md, "Maps across daemons"). The server accepts either; when both are set they
+// must agree, so that a request a proxy routed by its header cannot act on another map.
 // Pure functions; thread-safe.
 #pragma once
 

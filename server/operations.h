@@ -1,5 +1,5 @@
-// The daemon's long-running operations: update jobs (§IV-B), started by RunUpdate or the
-// schedule, run one after another on the registry's own thread — never on a gRPC thread — and
+// The daemon's long-running operations: update jobs (docs/update-job.md), started by RunUpdate or
+// the schedule, run one after another on the registry's own thread — never on a gRPC thread — and
 // kept for a while after they end so that clients can poll them.
 //
 // An operation is named "operations/update-<map>-<n>" (n counts from 1 in each daemon run) and
@@ -45,8 +45,8 @@ struct UpdateFigures {
   absl::Duration duration;  // filled by the registry: from the start of RUNNING to the end
   // Dynamic states by selected order 0..L once published.
   std::vector<uint64_t> order_histogram;
-  // Mean decayed ε_p at each state's selected order (SPEC §2.4): before = the orders the previous
-  // update chose, after = the orders this one chose.
+  // Mean decayed ε_p at each state's selected order (docs/model.md, "Order selection"): before =
+  // the orders the previous update chose, after = the orders this one chose.
   double prediction_error_before = 0;
   double prediction_error_after = 0;
 };

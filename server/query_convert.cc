@@ -32,11 +32,11 @@ void DynamicToProto(const model::ModelSettings& settings, const model::CompactSt
   if (include_spectrum) {
     for (size_t k = 0; k < spectrum.periods(); ++k) {
       const std::complex<double> gamma = spectrum.gamma(k);
-      // One-sided amplitude 2|γ_k|, as P holds it (SPEC §2.2).
+      // One-sided amplitude 2|γ_k|, as P holds it (docs/model.md, "Published model P").
       SetComponent(periods.period(k), 2 * std::abs(gamma), std::arg(gamma), *out.add_spectrum());
     }
   }
-  // A state with no P yet predicts γ0 (SPEC §2.2).
+  // A state with no P yet predicts γ0 (docs/model.md, "Published model P").
   const model::PublishedModel& p = m.published();
   out.set_published_mean(m.has_published() ? p.alpha0() : spectrum.gamma0());
   out.set_selected_order(m.has_published() ? p.order() : 0);

@@ -1,6 +1,7 @@
 // fremen.v1.QueryService over storage::MapStore: predictions (many states × many times, regions,
 // top-n of a group), anomaly checks, a state's full model, exact reconstruction of lossless
-// histories and map statistics (SPEC §2, §3). Every method is a read (read or write token).
+// histories and map statistics (docs/model.md, "Queries"). Every method is a read (read or write
+// token).
 //
 // Small predictions run inline on the gRPC thread (a single-state Predict is a few microseconds of
 // work; the hop to a pool would cost more); large ones, and the methods whose cost grows with the

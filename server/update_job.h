@@ -1,6 +1,6 @@
 // The update job over the store, and the daemon's update machinery built from it.
 //
-// The job of one map (§IV-B, SPEC §2.4): the map's statistics before, the publication — every
+// The job of one map (docs/update-job.md): the map's statistics before, the publication — every
 // dynamic state observed since its last update has its order chosen by its decayed prequential error
 // and its P republished (lossless maps: its history re-transformed, O rebuilt), one record
 // of the map's log so that recovery repeats it (storage::MapStore::PublishModels) — and the

@@ -80,8 +80,9 @@ inline constexpr size_t kMaxReportedRejections = 16;
 inline constexpr size_t kMaxLabelLength = 256;
 
 // The times the service accepts, for observations and for queries alike: seconds since the Unix
-// epoch, finite, in [0, 1e13] (SPEC §4: NaN, infinite, negative or absurd times are bad input;
-// the model maths itself accepts ±1e13). InvalidArgument naming `field` otherwise.
+// epoch, finite, in [0, 1e13] (docs/model.md, "Observations": NaN, infinite, negative or absurd
+// times are bad input; the model maths itself accepts ±1e13). InvalidArgument naming `field`
+// otherwise.
 absl::Status CheckTime(double t, absl::string_view field);
 
 // Checks what makes the whole batch unusable (the message names the field): the time (CheckTime), mismatched lengths, a patch outside the grid or with the wrong value count,

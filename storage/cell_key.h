@@ -3,9 +3,9 @@
 // Grid cells are keyed by the Morton (Z-order) code of their integer indices — 3-D (21 bits per
 // axis) for a grid of several layers, 2-D for a grid one cell thick, so that a 2-D map's keys are
 // dense — so that spatial neighbours are neighbours in LMDB's key order and a box is a few range
-// scans (SPEC §1). Generic states are keyed by their 64-bit id. A shard holds whole bricks — runs
-// of 512 consecutive keys (8×8×8 cells of a 3-D grid, 32×16 of a 2-D one) — so that a box touches
-// few shards' few ranges, and in memory a brick's states sit together.
+// scans. Generic states are keyed by their 64-bit id. A shard holds whole bricks — runs of 512
+// consecutive keys (8×8×8 cells of a 3-D grid, 32×16 of a 2-D one) — so that a box touches few
+// shards' few ranges, and in memory a brick's states sit together.
 // Pure functions; thread-safe.
 #pragma once
 

@@ -1,7 +1,8 @@
-// Crash safety (issue: "after kill -9 at any moment, a restart recovers every acknowledged batch and
-// the models equal a from-scratch computation over exactly those batches"): a child process ingests
-// scans and is SIGKILLed at random moments, mid-write, mid-sync or mid-checkpoint; after each kill
-// the store is reopened here and compared with a reference fed exactly the batches it holds.
+// Crash safety (docs/storage.md, "Recovery": after kill -9 at any moment, a restart recovers every
+// acknowledged batch and the models equal a from-scratch computation over exactly those batches): a
+// child process ingests scans and is SIGKILLed at random moments, mid-write, mid-sync or
+// mid-checkpoint; after each kill the store is reopened here and compared with a reference fed
+// exactly the batches it holds.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>

@@ -1,5 +1,5 @@
-// What the catalog knows about a map (SPEC §1): its name and kind, a grid's geometry, and the
-// model settings fixed at creation.
+// What the catalog knows about a map: its name and kind, a grid's geometry, and the model settings
+// fixed at creation (docs/model.md, "Map settings").
 //
 // A map is either a grid (2-D when size z is 1, or 3-D) whose states are cells addressed by integer
 // indices or metric points, or a set of generic states addressed by 64-bit id, with optional names
@@ -68,7 +68,8 @@ struct MapInfo {
   // Seconds; 0 = errors since the last update only. Default: 7 days.
   double error_half_life = model::kDefaultErrorHalfLife;
   model::ErrorCriterion criterion = model::ErrorCriterion::kThreshold;
-  // Lossless history (SPEC §2.5) with this sampling period in seconds; 0 = off. Default: off.
+  // Lossless history (docs/model.md, "Lossless history") with this sampling period in seconds;
+  // 0 = off. Default: off.
   double lossless_sampling_period = 0;
   // Origin of the lossless slot grid (slot 0 starts here), seconds.
   double lossless_origin = 0;

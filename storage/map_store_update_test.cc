@@ -1,4 +1,4 @@
-// The update job's storage side (issue 5): a publication updates only the states observed since
+// The update job's storage side (docs/update-job.md): a publication updates only the states observed since
 // their last one (and that survives checkpoints and restarts), runs a slice at a time while batches
 // keep being applied and acknowledged and readers see the old or the new model of each state, and
 // the interleaved result equals the recovery's replay of the log. Also run under the

@@ -64,7 +64,7 @@ struct ScanContext {
 };
 
 struct PredictOptions {
-  bool persistence = false;  // blend in the last observation (§III-D)
+  bool persistence = false;  // blend in the last observation (the persistence model)
   int order = -1;            // -1: each state's selected order
 };
 
@@ -116,11 +116,12 @@ class Shard {
   // Folds accepted observations (keys of this shard, values in [0, 1]) taken at the scan's time.
   void Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::span<const float> values);
   void ApplyLabels(std::span<const StateLabel> labels);
-  // --- the update of §IV-B (storage/shard_publication.cc) ---
+  // --- the update job (docs/update-job.md; storage/shard_publication.cc) ---
   // A publication updates every dynamic state touched (observed) since its own last publication:
-  // choose the order with the lowest decayed error and republish P from the spectrum (SPEC §2.4);
-  // on lossless maps also reconstruct, re-transform, re-select and rebuild O (SPEC §2.5). A state
-  // not touched since is left as it is, so a second run without new data changes nothing.
+  // choose the order with the lowest decayed error and republish P from the spectrum
+  // (docs/model.md, "Order selection"); on lossless maps also reconstruct, re-transform, re-select
+  // and rebuild O (docs/model.md, "Lossless history"). A state not touched since is left as it is,
+  // so a second run without new data changes nothing.
   //
   // It runs in slices between batches: BeginPublication marks the touched states pending, each
   // ContinuePublication publishes some of them, and a batch that observes a pending state publishes

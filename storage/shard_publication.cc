@@ -1,4 +1,4 @@
-// Shard's part of the update job (§IV-B; see "the update of §IV-B" in shard.h): which states a
+// Shard's part of the update job (docs/update-job.md; see "the update job" in shard.h): which states a
 // publication updates (those touched since their last one), publishing them a slice at a time so
 // that the map's batches and readers are never held off for long, and keeping the touched flags
 // across a checkpoint.

@@ -1,6 +1,6 @@
-// The store under damaged files (issue 11): a flipped bit in a record is DataLoss naming the file and key, never
-// another model; a damaged catalog record deletes nothing; a map whose file would make LMDB abort fails alone while the
-// others serve.
+// The store under damaged files (docs/storage.md, "When the disk misbehaves"): a flipped bit in a record is DataLoss
+// naming the file and key, never another model; a damaged catalog record deletes nothing; a map whose file would make
+// LMDB abort fails alone while the others serve.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -99,9 +99,9 @@ std::span<const uint8_t> Bytes(const std::string& s) { return {reinterpret_cast<
 
 std::string MapDir(const TempDir& dir, uint64_t id) { return dir.path() + "/maps/" + std::to_string(id); }
 
-// The issue: "3 of 1,024 models came back with a different spectrum and no error" after single-bit flips in shard
-// records. Now every flip of a bit of a record (value or checksum) is found: the map fails with DataLoss naming its
-// file and the record's key; no model is served from damaged bytes.
+// Before record checksums, 3 of 1,024 models came back with a different spectrum and no error after single-bit flips in
+// shard records. Now every flip of a bit of a record (value or checksum) is found: the map fails with DataLoss naming
+// its file and the record's key; no model is served from damaged bytes.
 TEST(StoreIntegrityTest, SingleBitFlipsInShardRecordsAreDataLossNeverAnotherModel) {
   TempDir dir;
   uint64_t id = 0;
@@ -177,7 +177,7 @@ TEST(StoreIntegrityTest, SingleBitFlipsInShardRecordsAreDataLossNeverAnotherMode
   EXPECT_NE(testing::ReadWholeFile(file), pristine);
 }
 
-// The issue: one flipped bit in the catalog changed a map's id, and the next start removed the map's directory as
+// Before: one flipped bit in the catalog changed a map's id, and the next start removed the map's directory as
 // unknown. Now the record is DataLoss, the map is failed, and nothing is removed.
 TEST(StoreIntegrityTest, ACatalogBitFlipDeletesNothingAndIsReported) {
   TempDir dir;
@@ -196,7 +196,7 @@ TEST(StoreIntegrityTest, ACatalogBitFlipDeletesNothingAndIsReported) {
   const std::string encoded = EncodeMapInfo(alpha);
   const std::vector<size_t> copies = testing::FindAll(testing::ReadWholeFile(catalog), Bytes(encoded));
   ASSERT_FALSE(copies.empty());
-  // version | name length | "alpha" | id: the id's lowest bit (the issue's "a map's id changes").
+  // version | name length | "alpha" | id: the id's lowest bit (the flip that used to change a map's id).
   for (const size_t at : copies) testing::FlipBit(catalog, at + 2 + alpha.name.size(), 0);
   const std::string alpha_dir = MapDir(dir, alpha.id);
   const std::string shard_file = alpha_dir + "/shard-0/data.mdb";
@@ -233,8 +233,8 @@ TEST(StoreIntegrityTest, ACatalogBitFlipDeletesNothingAndIsReported) {
   EXPECT_EQ(testing::ReadWholeFile(shard_file), before);
 }
 
-// The issue: a zeroed page in a shard's data.mdb aborted the daemon at start, naming nothing. Now the probe finds it:
-// Store::Open succeeds, the map is failed naming the file, the others serve.
+// Before the probe: a zeroed page in a shard's data.mdb aborted the daemon at start, naming nothing. Now the probe
+// finds it: Store::Open succeeds, the map is failed naming the file, the others serve.
 TEST(StoreIntegrityTest, AZeroedShardPageFailsThatMapAloneNamingTheFile) {
   TempDir dir;
   uint64_t bad_id = 0;

@@ -1,5 +1,5 @@
-// What a map's last update job did (issue 5: "record per map: when, how long, states updated, ε_p
-// before/after, the histogram of chosen orders"), kept by the map's store in the file
+// What a map's last update job did (docs/update-job.md, "What it records": when, how long, states
+// updated, ε_p before/after, the histogram of chosen orders), kept by the map's store in the file
 // <map dir>/last_update so that map statistics show it across restarts.
 // Value type and pure functions, except WriteUpdateRecord/ReadUpdateRecord (file I/O through
 // an Env); thread-safe.
@@ -20,7 +20,8 @@ struct UpdateRecord {
   double start_time = 0;        // Unix seconds
   double duration_seconds = 0;
   uint64_t states_updated = 0;  // states observed since their last update, republished
-  // The map's mean decayed ε_p at each state's selected order (SPEC §2.4) before and after.
+  // The map's mean decayed ε_p at each state's selected order (docs/model.md, "Order selection")
+  // before and after.
   double prediction_error_before = 0;
   double prediction_error_after = 0;
   // Dynamic states by selected order 0..L after the update.

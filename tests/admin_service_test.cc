@@ -1,8 +1,8 @@
-// End-to-end tests of fremen.v1.AdminService against the real fremend: every RPC; the update job
-// as an operation (two triggers make one job, progress reaches the total, cancellation of a
-// queued job, kill -9 mid-job); bad inputs with their exact codes; token roles; backup and
-// restore under a new name; and order selection on generated states of known true order
-// (issue 5): the job picks order 0, 1, 2 and 3 for states made of that many daily harmonics, as
+// End-to-end tests of fremen.v1.AdminService against the real fremend: every RPC; the update job as
+// an operation (two triggers make one job, progress reaches the total, cancellation of a queued
+// job, kill -9 mid-job); bad inputs with their exact codes; token roles; backup and restore under a
+// new name; and order selection on generated states of known true order (docs/model.md, "Order
+// selection"): the job picks order 0, 1, 2 and 3 for states made of that many daily harmonics, as
 // QueryService.GetStateModel then shows.
 //
 // Observations are written with storage::Store in the test process while the daemon is stopped
@@ -521,7 +521,7 @@ TEST_F(AdminServiceTokenTest, ReadTokenReadsButMayNotWrite) {
   EXPECT_EQ(Status(&status).error_code(), grpc::StatusCode::UNAUTHENTICATED);
 }
 
-// --- order selection (issue 5) ---
+// --- order selection (docs/model.md, "Order selection") ---
 
 // A state of true order `order`: a mean plus the first `order` of the daily, 12-hour and 8-hour
 // harmonics (all in the default Ω of 24 harmonics of a week), with phases of its own.
@@ -644,7 +644,8 @@ TEST_F(AdminServiceTest, UpdatesOnlyObservedStatesAndMapStatsKeepTheLastJob) {
 }
 
 // A lossless map's update reconstructs each history, re-transforms it, selects orders on it and
-// rebuilds the outlier set, and the past still reconstructs exactly (SPEC §2.5).
+// rebuilds the outlier set, and the past still reconstructs exactly (docs/model.md, "Lossless
+// history").
 TEST_F(AdminServiceTest, LosslessMapUpdateSelectsOrdersAndReconstructsExactly) {
   constexpr uint32_t kNx = 4, kNy = 2;
   constexpr double kDelta = 600;           // 10-minute slots

@@ -1,7 +1,8 @@
-// End-to-end tests of the operators' checks (issue 11): `fremenctl check MAP` (AdminService.CheckMap)
-// against a serving fremend, `fremend --verify` against a stopped data directory, and the
-// verification of a backup before `fremenctl restore` creates anything. Damage is done to the
-// files themselves, as a disk would: bytes flipped in a log segment, a page of a shard zeroed.
+// End-to-end tests of the operators' checks (storage/README.md, "Verification"): `fremenctl check
+// MAP` (AdminService.CheckMap) against a serving fremend, `fremend --verify` against a stopped data
+// directory, and the verification of a backup before `fremenctl restore` creates anything. Damage
+// is done to the files themselves, as a disk would: bytes flipped in a log segment, a page of a
+// shard zeroed.
 #include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
-// End-to-end: a damaged map file against the real fremend (issue 11). Two maps; one's shard file is damaged while the
-// daemon is stopped (a zeroed page, which makes LMDB abort the process that reads it, and a flipped bit in a record);
-// at restart the daemon serves the good map, GetServerStatus lists the bad one as failed naming its file, calls on it
-// answer DATA_LOSS, and nothing is deleted.
+// End-to-end: a damaged map file against the real fremend (docs/storage.md, "When the disk misbehaves"). Two maps;
+// one's shard file is damaged while the daemon is stopped (a zeroed page, which makes LMDB abort the process that reads
+// it, and a flipped bit in a record); at restart the daemon serves the good map, GetServerStatus lists the bad one as
+// failed naming its file, calls on it answer DATA_LOSS, and nothing is deleted.
 //
 // Observations are written with storage::Store in the test process while the daemon is stopped (tests/store_writer.h).
 #include <gmock/gmock.h>
@@ -199,9 +199,9 @@ TEST_F(FremendIntegrityTest, AFlippedBitInARecordIsDataLossNamingFileAndKey) {
   EXPECT_EQ(response.probabilities_size(), 0);
 }
 
-// The issue's case 3: one flipped bit changes a map's id in catalog/data.mdb. The daemon used to remove that map's
-// directory at the next start. Now the record is DATA_LOSS, the map is listed as failed, its directory is reported
-// (unknown_directories) and left, and the other map serves.
+// One flipped bit changes a map's id in catalog/data.mdb. The daemon used to remove that map's directory at the next
+// start. Now the record is DATA_LOSS, the map is listed as failed, its directory is reported (unknown_directories) and
+// left, and the other map serves.
 TEST_F(FremendIntegrityTest, ACatalogBitFlipDeletesNothingAndIsReported) {
   Connect();
   CreateGenericMap("alpha");

@@ -431,7 +431,7 @@ TEST_F(IngestServiceTest, BadTimesRefuseTheBatchAndTheStreamGoesOn) {
   Stream stream(*ingest_);
   const double bad[] = {std::nan(""), std::numeric_limits<double>::infinity(),
                         -std::numeric_limits<double>::infinity(), 1.1e13, -1.1e13,
-                        -1e9 /* before the epoch: SPEC §4 calls negative times bad */};
+                        -1e9 /* before the epoch: docs/model.md, "Observations", calls it bad */};
   uint64_t sequence = 0;
   for (double t : bad) {
     v1::IngestRequest request = RowBatch("lab", 1, ++sequence);

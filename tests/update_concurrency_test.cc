@@ -1,9 +1,9 @@
-// End-to-end: ingest and queries keep working while the update job publishes a large map (issue 5:
-// "runs while ingest and queries continue ... readers see the old or the new model of a state,
-// never a torn one"). A 1M-cell grid whose every cell is dynamic is updated over RunUpdate while
-// one client streams scans into part of the grid and another predicts the rest: scans are
-// acknowledged while the operation is PUBLISHING, and every prediction read is the cell's value
-// before the job or after it.
+// End-to-end: ingest and queries keep working while the update job publishes a large map
+// (docs/update-job.md, "How it runs beside ingest and queries": every read sees each state's old
+// model or its new one, never a mix). A 1M-cell grid whose every cell is dynamic is updated over
+// RunUpdate while one client streams scans into part of the grid and another predicts the rest:
+// scans are acknowledged while the operation is PUBLISHING, and every prediction read is the cell's
+// value before the job or after it.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 

@@ -1,10 +1,10 @@
-// fremen_ingest_load: the ingest load generator of issue 4. Against a running fremend it streams
-// scans of grid cells by index (default: 4 streams of 10k-cell scans, at most 8 unacknowledged
-// batches per stream, acknowledged only once durable) and prints the cell observations per second
-// acknowledged (the median of --repetitions windows), the batch rate and the acknowledgement
-// latency. It first prints what one scan costs to encode and decode (the CellIndices layout), and
-// finally the latency of single-state Predict calls when the daemon serves QueryService
-// (client/bench/fremen_query_load is the full query benchmark).
+// fremen_ingest_load: the ingest load generator (README.md, "Benchmarks"). Against a running
+// fremend it streams scans of grid cells by index (default: 4 streams of 10k-cell scans, at most 8
+// unacknowledged batches per stream, acknowledged only once durable) and prints the cell
+// observations per second acknowledged (the median of --repetitions windows), the batch rate and
+// the acknowledgement latency. It first prints what one scan costs to encode and decode (the
+// CellIndices layout), and finally the latency of single-state Predict calls when the daemon serves
+// QueryService (client/bench/fremen_query_load is the full query benchmark).
 //
 // The map (default "ingest-load", a 100×100×100 grid = 1M cells) is created when missing. Each
 // run writes as new writers (random ids), so runs against the same map are never duplicates.
@@ -364,7 +364,7 @@ void Client::Predict() const {
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app("fremen_ingest_load: ingest throughput of a running fremend (issue 4 benchmark)");
+  CLI::App app("fremen_ingest_load: ingest throughput of a running fremend (benchmark)");
   app.add_option("--address", o.address, "fremend's HOST:PORT")->capture_default_str();
   app.add_option("--map", o.map, "grid map to ingest into (created when missing)")->capture_default_str();
   app.add_option("--token", o.token, "bearer token with write access, when the daemon wants one");

@@ -1,5 +1,5 @@
-// fremen_query_load: measures QueryService as a C++ client sees it (issue 4's targets) and prints
-// medians:
+// fremen_query_load: measures QueryService as a C++ client sees it (targets: docs/performance.md,
+// "Targets") and prints medians:
 //   - PredictRegion of a box (default 1000×1000 = 1M cells) delivered as FLOAT and as UINT8:
 //     seconds per box and cells/s (target ≥ 100M cells/s);
 //   - single-state Predict: latency p50/p99 with one call in flight (targets p50 ≤ 200 µs,

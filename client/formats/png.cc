@@ -1,5 +1,6 @@
 // PNG encoding (see png.h). Layout: signature, IHDR, one IDAT, IEND; every chunk is
-// length (big-endian) | type | data | CRC-32 of type and data (PNG spec, §5.3).
+// length (big-endian) | type | data | CRC-32 of type and data (PNG specification, ISO/IEC 15948,
+// "Chunk layout").
 #include "client/formats/png.h"
 
 #include <zlib.h>

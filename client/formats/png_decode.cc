@@ -21,7 +21,7 @@ uint32_t BigEndian32(const std::string& bytes, size_t at) {
   return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | uint32_t{p[3]};
 }
 
-// The Paeth predictor of the PNG spec, §9.4.
+// The Paeth predictor of the PNG specification (ISO/IEC 15948, "Filter type 4: Paeth").
 uint8_t Paeth(int a, int b, int c) {
   const int p = a + b - c;
   const int pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);

@@ -72,7 +72,7 @@ void RegisterEvalCommand(CLI::App& app) {
       ->check(CLI::Range(0, model::kMaxMaxOrder))
       ->capture_default_str();
   eval->add_flag("--persistence", options->persistence,
-                 "Blend the last training observation into the predictions (persistence model, paper §III-D)");
+                 "Blend the last training observation into the predictions (persistence model)");
   eval->footer(
       "Trains one state on all of --train in one batch, then predicts every time of --test at each order\n"
       "0..L and prints one line per order: order<TAB>err<TAB>mse. err is the mean of |[p > 0.5] - s| (for 0/1\n"

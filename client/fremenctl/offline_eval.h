@@ -2,7 +2,7 @@
 // files, train one model on all the training data, and score its predictions of the test data at
 // every order 0..L.
 //
-// This is the client's one use of the model maths (SPEC §5 allows it for the offline eval): it
+// This is the client's one use of the model maths (docs/model.md, "Where the maths is used"): it
 // reproduces the original FremenServer's experiment (all training data in one batch, then a
 // prediction at every test time) so that figures can be compared with the published ones.
 // No threads; functions are pure apart from reading the named file.

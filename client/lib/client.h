@@ -39,7 +39,7 @@
 
 namespace fremen::client {
 
-// How the published model is evaluated (SPEC §2).
+// How the published model is evaluated (docs/model.md, "Published model P" and "Persistence").
 struct ModelOptions {
   // Blend in the last observation with the persistence model (maps created with persistence).
   bool persistence = false;

@@ -1,4 +1,4 @@
-// Load generator for the map store (issue 3's benchmarks): prints figures, asserts nothing.
+// Load generator for the map store (README.md, "Benchmarks"): prints figures, asserts nothing.
 //
 // A 1M-cell 3-D grid (100×100×100), default Ω, 2 shards, durable acknowledgements (group commit)
 // included: ingest of spatially coherent and of random 10k-cell scans, region prediction of all

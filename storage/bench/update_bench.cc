@@ -1,4 +1,4 @@
-// Load generator for the update job (issue 5's benchmarks): prints figures, asserts nothing.
+// Load generator for the update job (README.md, "Benchmarks"): prints figures, asserts nothing.
 //
 //  1. choose + publish, states/s per core (K = 24, L = 5): a 1M-dynamic-state grid map with one
 //     shard, PublishModels timed (the store's path: order choice, top-L, flags, under the shard's

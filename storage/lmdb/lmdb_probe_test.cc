@@ -60,8 +60,8 @@ TEST(LmdbProbeTest, HealthyEnvironmentsPassAndMissingOnesAreSkipped) {
   EXPECT_TRUE(ReadEverything(dir.path() + "/a").ok());
 }
 
-// The case: a zeroed page in the middle of a data file makes LMDB abort the process that reads it. The probe's
-// child takes the abort; the caller gets DataLoss naming the file.
+// The case the probe exists for: a zeroed page in the middle of a data file makes LMDB abort the process that reads it.
+// The probe's child takes the abort; the caller gets DataLoss naming the file.
 TEST(LmdbProbeTest, AZeroedPageIsReportedNamingTheFileInsteadOfAborting) {
   fremen::testing::TempDir dir;
   const std::string good = dir.path() + "/good", bad = dir.path() + "/bad";

@@ -1,5 +1,6 @@
-// The published model P of a lossless history (paper §III-B, SPEC §2.5): α0 and up to L components
-// at FFT-bin frequencies of the slot signal it was computed from, and the selected order l ≤ L.
+// The published model P of a lossless history (docs/model.md, "Lossless history"): α0 and up to L
+// components at FFT-bin frequencies of the slot signal it was computed from, and the selected order
+// l ≤ L.
 //
 // With n the number of slots transformed, component j is bin k_j (period n/k_j slots) held as
 // a_j = α_j cos φ_j, b_j = α_j sin φ_j (α_j = 2|γ_k|: one-sided amplitude, φ_j = arg γ_k; the Nyquist
@@ -47,7 +48,8 @@ class BinModel {
   // The `max_order` strongest bins of `spectrum` by |γ_k| (ties to the lower bin), sorted by
   // amplitude, with the order set to the number held. Bin 0 is α0, not a component; a bin whose
   // period n/k exceeds 2/3 of `span` (slots between the first and last observation) cannot be
-  // estimated yet and is not eligible (SPEC §2.2's gate). REQUIRES: spectrum.length() ≤ kMaxBinLength.
+  // estimated yet and is not eligible (the 2/3-span gate of docs/model.md, "Published model P").
+  // REQUIRES: spectrum.length() ≤ kMaxBinLength.
   static BinModel FromSpectrum(const SlotSpectrum& spectrum, uint64_t span, int max_order);
 
   // n, the number of slots the model was computed from; 0 before the first update.

@@ -1,4 +1,4 @@
-// The spectrum of a uniformly sampled binary signal with gaps, by FFT (paper §III-B step 3, §III-C):
+// The spectrum of a uniformly sampled binary signal with gaps, by FFT (docs/model.md, "Lossless history"):
 //   γ0 = mean of the observed samples,  γ_k = (1/n_obs) Σ_observed (s_i − γ0) e^{−j2πki/n},  k = 0..n/2,
 // for a signal of n slots. Unobserved slots contribute nothing beyond the mean: this equals the FFT of
 // the signal with the gaps filled by γ0, divided by n_obs, and for a fully observed signal it is the

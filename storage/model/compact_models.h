@@ -1,5 +1,5 @@
-// CompactModels: the published models P (SPEC §2.2) of many states in a flat array of fixed-stride
-// records, what region queries and prequential scoring read.
+// CompactModels: the published models P (docs/model.md, "Published model P") of many states in a
+// flat array of fixed-stride records, what region queries and prequential scoring read.
 //
 // Record for max order L (stride 8 + 2·L' + 8·L bytes, L' = L rounded up to even; 60 B at L = 5):
 //   CompactModelHeader {float alpha0; uint8 order; uint8 published; uint16 count}  8 B
@@ -10,7 +10,7 @@
 // without comparing it to count: the extra terms add exactly zero. That is PublishedModel::Predict's
 // "an order above the components held uses all of them".
 //
-// A state without P (published = 0) predicts alpha0 (its γ0, SPEC §2.2) at every order and is not
+// A state without P (published = 0) predicts alpha0 (its γ0) at every order and is not
 // scored. New records are unpublished with alpha0 = 0.5 (γ0 of an empty spectrum).
 // Thread-safety: none; one writer, or many readers of an unchanging table.
 #pragma once

@@ -151,7 +151,8 @@ absl::StatusOr<int> LosslessHistory::Update(int max_order, std::optional<int> or
   std::vector<SlotState> signal(m);
   ReconstructInto(0, signal);
 
-  // The published P scores the orders on what it had not seen, before it is replaced (§IV-B).
+  // The published P scores the orders on what it had not seen, before it is replaced
+  // (docs/model.md, "Order selection").
   // A P without components (the first update, or nothing was eligible then) predicted nothing
   // worth scoring: the new components are scored on all data instead.
   std::vector<uint64_t> errors(max_order + 1, 0);

@@ -1,4 +1,5 @@
-// The lossless history of one binary state (SPEC §2.5; paper §III-B eq. 7-9, §IV-A eq. 14-16).
+// The lossless history of one binary state (docs/model.md, "Lossless history"; the FreMEn paper's
+// eq. 7-9 and 14-16).
 //
 // The state is sampled on a uniform grid: slot i covers [t0 + iΔ, t0 + (i+1)Δ). The history keeps
 //  - P, a BinModel: α0 and up to L components at FFT-bin frequencies 2πk/(nΔ) of the reconstructed
@@ -10,7 +11,7 @@
 // slot is reported as unobserved. A slot observed again keeps its latest value. Soft values are
 // thresholded (s ≥ 0.5 → 1): the history is binary.
 //
-// Update() is the paper's model update (§III-B 3, §IV-B): reconstruct, pick the order that best
+// Update() is the paper's model update (docs/update-job.md): reconstruct, pick the order that best
 // predicted the slots observed since the last update, re-transform (FFT), publish P, rebuild O.
 // ε_e and ε_p come from O and the coverage by eq. 15, in O(toggle points).
 //
@@ -79,14 +80,14 @@ class LosslessHistory {
   double Predict(double t, int order = -1) const;
 
   // The model update. Picks the order l in 0..max_order with the fewest wrong estimates s' on the
-  // slots observed since the last update, scored with the P published then, which predicted them
-  // (the paper's prequential choice, §IV-B; ties to the lower order). When that P has no components
-  // (the first update, or none were eligible yet) the new components are scored on all data instead;
-  // with nothing observed since, the order stays. A given `order` skips the choice. Then publishes
-  // the max_order strongest eligible bins of the FFT of the reconstruction, rebuilds O against them
-  // and sets update_slot() to m. Returns the order published (at most the components found).
-  // InvalidArgument for max_order outside [0, kMaxMaxOrder] or order outside [0, max_order]. With
-  // nothing observed, changes nothing.
+  // slots observed since the last update, scored with the P published then, which predicted them (the
+  // prequential choice of docs/model.md, "Order selection"; ties to the lower order). When that P has
+  // no components (the first update, or none were eligible yet) the new components are scored on all
+  // data instead; with nothing observed since, the order stays. A given `order` skips the choice.
+  // Then publishes the max_order strongest eligible bins of the FFT of the reconstruction, rebuilds O
+  // against them and sets update_slot() to m. Returns the order published (at most the components
+  // found). InvalidArgument for max_order outside [0, kMaxMaxOrder] or order outside [0, max_order].
+  // With nothing observed, changes nothing.
   absl::StatusOr<int> Update(int max_order, std::optional<int> order = std::nullopt);
 
   // Eq. 15 restricted to observed slots: wrong = |O ∩ observed ∩ [begin, end)|, the slots where

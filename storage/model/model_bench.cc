@@ -1,5 +1,6 @@
-// Benchmarks of the batch kernels against the per-core targets, at the default Ω (K = 24)
-// and L = 5, on data sizes far beyond the caches (the machine: 2 cores, 32 MiB L3, ~50 GB/s read+write).
+// Benchmarks of the batch kernels against their per-core targets (docs/performance.md, "Targets"), at
+// the default Ω (K = 24) and L = 5, on data sizes far beyond the caches (the machine: 2 cores, 32 MiB
+// L3, ~50 GB/s read+write).
 //
 //   update, cells sharing one scan time   dense ≥ 50M cell-obs/s, random ≥ 20M   (BM_Update*)
 //   region prediction of 1M cells         l = 2 ≥ 300M/s, l = 5 ≥ 150M/s         (BM_Predict*)
@@ -298,11 +299,11 @@ void BM_PublishSingleStateReference(benchmark::State& state) {
 }
 BENCHMARK(BM_PublishSingleStateReference)->Unit(benchmark::kMillisecond);
 
-// This machine's limits in the same run (PERF-NOTES: compare as ratios inside one run, the machine is
-// shared): a vectorised read-modify-write stream over the dense benchmark's 448 MiB, in records/s
-// of 448 B; and one word rewritten per cache line of the random benchmark's records (prefetched),
-// in records/s. A kernel cannot beat these. Both XOR with a zero the compiler cannot see, so that the
-// records stay intact for the other benchmarks.
+// This machine's limits in the same run (docs/performance.md: compare as ratios inside one run, the
+// machine is shared): a vectorised read-modify-write stream over the dense benchmark's 448 MiB, in
+// records/s of 448 B; and one word rewritten per cache line of the random benchmark's records
+// (prefetched), in records/s. A kernel cannot beat these. Both XOR with a zero the compiler cannot see,
+// so that the records stay intact for the other benchmarks.
 uint32_t OpaqueZero() {
   uint32_t zero = 0;
   benchmark::DoNotOptimize(zero);

@@ -1,4 +1,5 @@
-// The model settings of a map (SPEC §1): fixed at creation, shared by all its states.
+// The model settings of a map (docs/model.md, "Map settings"): fixed at creation, shared by all its
+// states.
 #pragma once
 
 #include "storage/model/order_errors.h"
@@ -15,7 +16,7 @@ struct ModelSettings {
   PeriodSet periods = PeriodSet::Default();
   // L, the most components P may hold. Default: 5. REQUIRES: 0 <= max_order <= 64.
   int max_order = kDefaultMaxOrder;
-  // Whether predictions may blend in the last observation (§III-D). Default: on.
+  // Whether predictions may blend in the last observation (docs/model.md, "Persistence"). Default: on.
   bool persistence = true;
   // Half-life of the prequential error counters, seconds; 0 = count only since the last update.
   // Longer remembers more evidence but adapts slower to a change of the dynamics. Default: 7 days.

@@ -1,5 +1,6 @@
-// OrderErrorTable: the prequential per-order error counters (OrderErrors, SPEC §2.4) of many states in
-// a flat array of fixed-stride records, updated by the scan kernels in the same pass as the spectra.
+// OrderErrorTable: the prequential per-order error counters (OrderErrors; docs/model.md, "Order
+// selection") of many states in a flat array of fixed-stride records, updated by the scan kernels in
+// the same pass as the spectra.
 //
 // Record for max order L: double t_ref, weight, errors[L + 1] — (L + 3)·8 bytes, one 64-byte line at
 // L = 5. Add() is OrderErrors::Add, operation for operation (the tests pin equality), on a record

@@ -1,4 +1,4 @@
-// Prequential per-order error counters and order selection (SPEC §2.4, paper §IV-B).
+// Prequential per-order error counters and order selection (docs/model.md, "Order selection").
 //
 // Every observation, before it is folded into the spectrum, is scored against the published model
 // at each order 0..L. The sums decay exponentially with a half-life (default 7 days) relative to the

@@ -1,4 +1,4 @@
-// The set Ω of modelled periods of a map (SPEC §1, paper §III-C).
+// The set Ω of modelled periods of a map (docs/model.md, "Map settings" and "Spectrum").
 //
 // A PeriodSet is an immutable list of periods in seconds, longest first. The model of every state of
 // a map is expressed against the same Ω, so a batch of observations taken at one time can share one

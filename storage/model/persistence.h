@@ -1,4 +1,4 @@
-// The persistence model of one state (SPEC §2.3, paper §III-D eq. 12-13).
+// The persistence model of one state (docs/model.md, "Persistence"; the FreMEn paper's eq. 12-13).
 //
 // Keeps the last observation (t_l, s(t_l)) and τ⁻¹, the running mean of |s(t) − s(t_l)|/(t − t_l)
 // over consecutive observations; the short-term prediction blends the last observation into the

@@ -1,5 +1,5 @@
 // Phasors e^{-jωt} of every period of Ω at one time, computed once and shared by every state
-// observed or predicted at that time (PERF-NOTES: "the key insight").
+// observed or predicted at that time (docs/performance.md, "One scan shares its phasors").
 //
 // Phases are range-reduced in double precision: ω·t at t ≈ 1.7e9 s is garbage in float (128 s ulp),
 // and even in double loses digits unless t is first reduced modulo the period (fmod is exact).

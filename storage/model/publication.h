@@ -1,9 +1,10 @@
-// Publication, the update job's inner loop (SPEC §2.2, §2.4): for each state choose the order with the
-// lowest decayed prequential error, take the L strongest eligible components of its float spectrum
-// and write its compact P. The result equals PublishedModel::FromSpectrum with
-// OrderErrors::BestOrder's order, bit for bit (the tests pin it), without its per-state heap vectors
-// and sort: γ_k is taken on the fly, the top L are kept by insertion into a small stack array, ranked by
-// |γ|² (no square root) except in near-ties, where |γ| itself decides as in FromSpectrum.
+// Publication, the update job's inner loop (docs/model.md, "Published model P" and "Order selection"):
+// for each state choose the order with the lowest decayed prequential error, take the L strongest
+// eligible components of its float spectrum and write its compact P. The result equals
+// PublishedModel::FromSpectrum with OrderErrors::BestOrder's order, bit for bit (the tests pin it),
+// without its per-state heap vectors and sort: γ_k is taken on the fly, the top L are kept by insertion
+// into a small stack array, ranked by |γ|² (no square root) except in near-ties, where |γ| itself
+// decides as in FromSpectrum.
 //
 // The job clears the error counters after publishing when the map's half-life is 0 (the paper's
 // "only since the last update"); that is the caller's policy, not done here.

@@ -1,4 +1,5 @@
-// The published model P of one state (SPEC §2.2, paper §III-B eq. 9-10) and what is computed from it.
+// The published model P of one state (docs/model.md, "Published model P"; the FreMEn paper's
+// eq. 9-10) and what is computed from it.
 //
 // P holds α0 = γ0 and the L strongest eligible components of the spectrum, sorted by amplitude, and
 // the selected order l ≤ L:  p(t) = ς(α0 + Σ_{j<l} α_j cos(ω_j t + φ_j)),  α_j = 2|γ_j|, φ_j = arg γ_j,
@@ -82,8 +83,8 @@ inline double Clamp01(double p) { return p < 0 ? 0 : (p > 1 ? 1 : p); }
 // s'(t, c) = p(t) ≥ c (eq. 9).
 inline bool EstimateState(double p, double confidence) { return p >= confidence; }
 
-// Anomalous at confidence c: s = 1 while p < 1 − c, or s = 0 while p > c (SPEC §2.6). Soft
-// observations count as 1 when ≥ 0.5.
+// Anomalous at confidence c: s = 1 while p < 1 − c, or s = 0 while p > c (docs/model.md,
+// "Queries"). Soft observations count as 1 when ≥ 0.5.
 inline bool IsAnomalous(double s, double p, double confidence) {
   return s >= 0.5 ? p < 1.0 - confidence : p > confidence;
 }

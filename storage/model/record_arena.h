@@ -6,7 +6,8 @@
 // FoldObservation never splits a load across lines) while the header fills the tail: at K = 24 the
 // record is 384 + 32 = 416 B, stride 448 B = 7 lines (≤ 16·K + 64). Array of structs, not struct of
 // arrays: one scan touches scattered cells, and each cell's record is then a few adjacent lines
-// (PERF-NOTES: struct of arrays with scattered cells is 10-25x slower).
+// (docs/performance.md, "One scan shares its phasors": struct of arrays with scattered cells is
+// 10-25x slower).
 //
 // A new record is an empty spectrum (all zero: n = 0), equal to CompactSpectrum(periods).
 // Thread-safety: none; one writer owns an arena (readers only while nothing writes). Resize and

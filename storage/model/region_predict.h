@@ -1,9 +1,10 @@
-// Region prediction (SPEC §3 queries): p(t) of many compact models at one time t.
+// Region prediction (docs/model.md, "Queries"): p(t) of many compact models at one time t.
 //
 // The per-query table cos ω_k t, sin ω_k t (float, from a PhasorTable built once per query in double
-// with range reduction) turns each state's prediction into l multiply-adds: no trigonometry per
-// state (PERF-NOTES: a cosf per cell is ~15x slower). float is ample: the result is within ~1e-6 of
-// PublishedModel::Predict's double, and a served probability is float or a byte anyway.
+// with range reduction) turns each state's prediction into l multiply-adds: no trigonometry per state
+// (docs/performance.md, "One scan shares its phasors": a cosf per cell is ~15x slower). float is
+// ample: the result is within ~1e-6 of PublishedModel::Predict's double, and a served probability is
+// float or a byte anyway.
 // Thread-safety: pure functions; concurrent calls on the same unchanging CompactModels are fine.
 #pragma once
 

@@ -1,5 +1,6 @@
 // The ingest kernels: one scan (one time t, many cells) folded into the working records of a map or
-// shard, optionally scoring each cell's published model first (SPEC §2.1, §2.4).
+// shard, optionally scoring each cell's published model first (docs/model.md, "Spectrum" and "Order
+// selection").
 //
 // Everything per scan is computed once (ScanPhasors: the phasors of t in double with range
 // reduction, cast to float); per cell the update is FoldObservation — 4K float multiply-adds on one

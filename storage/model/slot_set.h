@@ -1,5 +1,6 @@
 // A set of slot indices (non-negative integers) stored as its toggle points, Δ-encoded as varints
-// (paper §III-B eq. 8: "a sequence of values indicating the starts and ends of time intervals").
+// (the FreMEn paper, Krajník et al., IEEE T-RO 2017, eq. 8: "a sequence of values indicating the
+// starts and ends of time intervals"; docs/model.md, "Lossless history").
 //
 // Toggle points p_0 < p_1 < ... : slot x is a member iff an odd number of points are ≤ x, so the
 // members are [p_0, p_1) ∪ [p_2, p_3) ∪ ... and, with an odd number of points, [p_last, ∞). The open

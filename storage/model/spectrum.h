@@ -1,11 +1,13 @@
-// The incremental spectrum of one state (SPEC §2.1, paper §III-C eq. 11, with exact mean removal).
+// The incremental spectrum of one state (docs/model.md, "Spectrum"; the FreMEn paper's eq. 11, with
+// exact mean removal).
 //
 // For every ω_k of Ω it keeps the running means S̄_k = (1/n)·Σ s·e^{-jω_k t} and
 // Ē_k = (1/n)·Σ e^{-jω_k t}, plus the exact count n, Σs and the observed span. Then
 //   γ0 = Σs / n,   γ_k = S̄_k − γ0·Ē_k   (= (S_k − γ0·E_k)/n),
 // which does not depend on how the observations were split into batches or in which order they came
 // (beyond rounding), and two spectra merge into the spectrum of the union of their observations.
-// Running means (magnitude ≤ 1) stay accurate where raw sums would not (PERF-NOTES).
+// Running means (magnitude ≤ 1) stay accurate where raw sums would not (docs/performance.md,
+// "Precision").
 //
 // Two precisions share the code: `Spectrum` (double) for generic states, where exactness is cheap,
 // and `CompactSpectrum` (float) for the millions of grid cells, where memory bandwidth is the cost.

@@ -1,5 +1,5 @@
-// The complete incremental FreMEn model of one state (SPEC §2.1-2.4, 2.6-2.7): spectrum, published
-// model, persistence and prequential order errors, composed.
+// The complete incremental FreMEn model of one state (docs/model.md): spectrum, published model,
+// persistence and prequential order errors, composed.
 //
 // Observations update the spectrum, the persistence state and the error counters at once; the
 // published model only changes on Update() (the nightly job) or Publish(). Predictions read the

@@ -1,5 +1,5 @@
-// A state that has never changed value (SPEC §1: "cells that have never changed state cost almost
-// nothing"). 16 bytes: its value, count and observed span. Its spectrum is exactly γ0 = value with
+// A state that has never changed value (docs/model.md, "Never-changed states": they cost almost
+// nothing). 16 bytes: its value, count and observed span. Its spectrum is exactly γ0 = value with
 // every γ_k = 0, its persistence rate is 0 and it is implicitly published as order 0, so none of
 // those need storing until the first change.
 //

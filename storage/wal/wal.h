@@ -1,6 +1,7 @@
 // The write-ahead log of one map: an append-only sequence of records, each acknowledged batch of
 // observations, made durable by group commit (many records, one fdatasync) and replayed after a
-// crash on top of the last checkpoint (PERF-NOTES: LMDB cannot sit on the per-observation path).
+// crash on top of the last checkpoint (docs/performance.md, "LMDB cannot sit on the
+// per-observation path").
 //
 // Files: <dir>/wal-<first LSN, 20 digits>.log, rolled over at Options::segment_bytes. A record is
 //   u32 payload length | u32 CRC-32 of (LSN, payload) | u64 LSN | payload        (little-endian)

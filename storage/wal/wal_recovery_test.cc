@@ -1,5 +1,6 @@
 // A map's recovery from a damaged write-ahead log (storage/README.md, "Torn tail and corruption"):
-// the two losses of issue 11 (cases 1 and 2), pinned by name.
+// the two losses it once caused — a corrupt record taken for a torn tail and cut, and records
+// written below the checkpoint's LSN and then skipped — each pinned by a test of the whole store.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -35,7 +36,7 @@ StoreOptions NoCheckpointsUntilClose() {
 
 // Before: replay took the flip for a torn tail, cut the log there and served the map without the 20
 // acknowledged batches after it.
-TEST(WalRecoveryTest, Issue11ACorruptRecordAfterAcknowledgedBatchesFailsTheMapAndCutsNothing) {
+TEST(WalRecoveryTest, ACorruptRecordAfterAcknowledgedBatchesFailsTheMapAndCutsNothing) {
   fremen::testing::TempDir dir, image;
   const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
   {
@@ -61,7 +62,7 @@ TEST(WalRecoveryTest, Issue11ACorruptRecordAfterAcknowledgedBatchesFailsTheMapAn
 
 // Before: the writer resumed at the cut record's LSN, at or below the shards' checkpoint, and the
 // next recovery skipped the new records as checkpointed (20 of 30 acknowledged batches gone).
-TEST(WalRecoveryTest, Issue11RecordsWrittenAfterARecoveryNeverFallBelowTheCheckpoint) {
+TEST(WalRecoveryTest, RecordsWrittenAfterARecoveryNeverFallBelowTheCheckpoint) {
   fremen::testing::TempDir dir, image;
   const MapInfo map = testing::GridMap("m", 32, 32, 1, 2);
   {

@@ -171,8 +171,8 @@ void WriteRecords(const std::string& dir, uint64_t n) {
   }
 }
 
-// Issue 11, case 1: a bad record of the last segment was taken for a torn tail, and everything
-// after it was cut.
+// Before the torn-tail rule (storage/README.md, "Torn tail and corruption"): a bad record of the
+// last segment was taken for a torn tail, and everything after it was cut.
 TEST(WalTest, CorruptionIsNotATornTailAMidSegmentFlipIsDataLossAndNothingIsCut) {
   fremen::testing::TempDir dir;
   WriteRecords(dir.path(), 40);
@@ -236,8 +236,8 @@ TEST(WalTest, ALastRecordWithABadCrcOrZerosAtTheEndIsATornTail) {
   }
 }
 
-// Issue 11, case 2: the writer resumed below the shards' checkpoint LSN, and a later recovery
-// skipped the new records as checkpointed.
+// Before the LSN floor (storage/README.md, "Torn tail and corruption"): the writer resumed below
+// the shards' checkpoint LSN, and a later recovery skipped the new records as checkpointed.
 TEST(WalTest, TheWriterNeverGoesBelowItsLsnFloor) {
   fremen::testing::TempDir dir;
   WriteRecords(dir.path(), 10);

@@ -1,7 +1,8 @@
 """A state's model (QueryService.GetStateModel) as plain Python objects, and p(t) computed from it.
 
 p(t) = clamp(α0 + Σ_{j < order} α_j cos(2π t / T_j + φ_j), 0, 1) over the published components
-(SPEC §2.2, paper eq. 10): the same formula the daemon's Predict evaluates (without persistence).
+(docs/model.md, "Published model P"; the FreMEn paper's eq. 10): the same formula the daemon's
+Predict evaluates (without persistence).
 """
 
 import dataclasses

@@ -26,7 +26,8 @@ def office_hours(t):
 
 class QueriesTest(DaemonTestCase):
     # The first update publishes P at order 0 (no order has been scored yet); the second scores
-    # the second week against the first P at every order and selects one (SPEC §2.4).
+    # the second week against the first P at every order and selects one (docs/model.md,
+    # "Order selection").
     def fill_doors(self):
         self.client.create_map("doors")
         for week in range(WEEKS):
