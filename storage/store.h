@@ -12,7 +12,7 @@
 // - A directory under maps/ that no catalog record names (a catalog record lost to damage, or a crash between a
 //   delete's catalog commit and its file removal) is left where it is and listed in UnknownDirectories() for an
 //   operator; no new map is given its id. Only DeleteMap removes a map's files, and only those of the map the catalog
-//   names; CreateMap and RestoreMap, when they fail, remove only the directory they created.
+//   names; CreateMap, RestoreMap and SalvageMap, when they fail, remove only the directory they created.
 //
 // Thread-safety: every method may be called from any thread.
 #pragma once
@@ -26,6 +26,7 @@
 #include "absl/status/statusor.h"
 #include "storage/catalog.h"
 #include "storage/map_store.h"
+#include "storage/salvage.h"
 
 namespace fremen::storage {
 
@@ -58,6 +59,12 @@ class Store {
   // A backup made by BackupMap as a new map named `name` (empty: the backed-up map's name). The copy is probed and
   // loaded (every record checked) before the map is listed.
   absl::StatusOr<MapInfo> RestoreMap(const std::string& dir, const std::string& name);
+
+  // A new map `new_name` (empty: name + "-salvaged") holding everything of the failed map `name` that verifies, served
+  // once it opens like any other (storage/salvage.h); the failed map and its files are left as they are. NotFound for
+  // an unknown map, FailedPrecondition for one that is not failed (it is copied with BackupMap/RestoreMap), AlreadyExists
+  // when new_name is taken. When the copy does not open, only the directory this call made is removed.
+  absl::StatusOr<SalvageReport> SalvageMap(const std::string& name, const std::string& new_name);
 
   // Maps that did not open at Open, in name order.
   std::vector<FailedMap> FailedMaps() const;

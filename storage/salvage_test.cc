@@ -1,0 +1,294 @@
+// Store::SalvageMap on maps damaged as a bad disk would damage them: a flipped bit in a shard record, a zeroed LMDB
+// page that makes LMDB abort, a corrupt record in the middle of the log. What verifies is kept, exactly, what does not
+// is reported, and the damaged map's files are left as they were.
+#include "storage/salvage.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "absl/strings/escaping.h"
+#include "absl/strings/str_cat.h"
+#include "storage/store.h"
+#include "storage/testing/crash_image.h"
+#include "storage/testing/file_damage.h"
+#include "storage/testing/labelled_states.h"
+#include "storage/testing/temp_dir.h"
+
+namespace fremen::storage {
+namespace {
+
+using testing::Bytes;
+using testing::Fill;
+using testing::Fingerprints;
+using testing::Generic;
+using testing::kStates;
+using testing::Record;
+using testing::ShardRecords;
+using testing::TempDir;
+
+std::string MapDir(const TempDir& dir, uint64_t id) { return dir.path() + "/maps/" + std::to_string(id); }
+
+const SalvageDatabase& Db(const SalvageReport& report, const std::string& name) {
+  for (const SalvageDatabase& d : report.shards.at(0).databases) {
+    if (d.name == name) return d;
+  }
+  static const SalvageDatabase none;
+  ADD_FAILURE() << "no database " << name << " in the report";
+  return none;
+}
+
+std::vector<Record> RecordsOf(const std::string& shard_dir, const std::string& db) {
+  std::vector<Record> out;
+  for (Record& r : ShardRecords(shard_dir)) {
+    if (r.db == db) out.push_back(std::move(r));
+  }
+  return out;
+}
+
+// A store with map "m" filled and closed (so checkpointed); returns the map's info and every state's model.
+MapInfo FilledMap(const TempDir& dir, std::map<uint64_t, std::string>& models) {
+  auto store = Store::Open(dir.path(), {});
+  EXPECT_TRUE(store.ok()) << store.status();
+  auto info = (*store)->CreateMap(Generic("m"));
+  EXPECT_TRUE(info.ok()) << info.status();
+  auto map = *(*store)->Map("m");
+  Fill(*map);
+  models = Fingerprints(*map);
+  return *info;
+}
+
+TEST(SalvageTest, OnlyAFailedMapIsSalvagedAndNamesAreChecked) {
+  TempDir dir;
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok());
+  ASSERT_TRUE((*store)->CreateMap(Generic("m")).ok());
+  ASSERT_TRUE((*store)->CreateMap(Generic("other")).ok());
+  auto healthy = (*store)->SalvageMap("m", "");
+  ASSERT_TRUE(absl::IsFailedPrecondition(healthy.status())) << healthy.status();
+  EXPECT_EQ(healthy.status().message(), "map m is not damaged; use BackupMap/RestoreMap to copy it");
+  auto unknown = (*store)->SalvageMap("nope", "");
+  EXPECT_TRUE(absl::IsNotFound(unknown.status())) << unknown.status();
+  EXPECT_NE(unknown.status().message().find("nope"), std::string::npos);
+  EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("m-salvaged").status()));
+}
+
+TEST(SalvageTest, AFlippedBitLosesThatRecordAndKeepsEveryOther) {
+  TempDir dir;
+  std::map<uint64_t, std::string> want;
+  const MapInfo info = FilledMap(dir, want);
+  ASSERT_EQ(want.size(), kStates);
+  const std::string shard_dir = MapDir(dir, info.id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::vector<Record> dynamic = RecordsOf(shard_dir, "dynamic");
+  const size_t statics = RecordsOf(shard_dir, "static").size();
+  ASSERT_EQ(dynamic.size(), kStates - kStates / 4);
+  const Record& victim = dynamic[dynamic.size() / 3];
+  const uint64_t victim_key = KeyFromBytes(reinterpret_cast<const uint8_t*>(victim.key.data()));
+  for (const size_t at : testing::FindAll(testing::ReadWholeFile(file), Bytes(victim.value))) {
+    testing::FlipBit(file, at + victim.value.size() / 2, 3);
+  }
+  const std::string damaged = testing::ReadWholeFile(file);
+
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok()) << store.status();
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);
+  // The name taken by another map is refused before anything is made.
+  ASSERT_TRUE((*store)->CreateMap(Generic("taken")).ok());
+  auto taken = (*store)->SalvageMap("m", "taken");
+  ASSERT_TRUE(absl::IsAlreadyExists(taken.status())) << taken.status();
+  EXPECT_NE(taken.status().message().find("new_map"), std::string::npos) << taken.status();
+
+  auto report = (*store)->SalvageMap("m", "");
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_EQ(report->from, "m");
+  EXPECT_EQ(report->map.name, "m-salvaged");
+  EXPECT_NE(report->map.id, info.id);
+  EXPECT_EQ(report->map.kind, info.kind);
+  EXPECT_EQ(report->map.shards, info.shards);
+  ASSERT_EQ(report->shards.size(), 1u);
+  EXPECT_EQ(Db(*report, "dynamic").kept, dynamic.size() - 1);
+  EXPECT_EQ(Db(*report, "dynamic").lost, 1u);
+  EXPECT_EQ(Db(*report, "static").kept, statics);
+  EXPECT_EQ(Db(*report, "labels").kept, kStates);
+  EXPECT_EQ(report->records_lost(), 1u);
+  ASSERT_EQ(report->losses, 1u);
+  ASSERT_EQ(report->lost.size(), 1u);
+  EXPECT_EQ(report->lost[0].file, "shard-0/data.mdb");
+  EXPECT_NE(report->lost[0].what.find("key " + absl::BytesToHexString(victim.key)), std::string::npos)
+      << report->lost[0].what;
+
+  // Served: every state as it was, but the one whose record was lost, which has no changed model.
+  auto salvaged = (*store)->Map("m-salvaged");
+  ASSERT_TRUE(salvaged.ok()) << salvaged.status();
+  std::map<uint64_t, std::string> got = Fingerprints(**salvaged), expected = want;
+  const auto lost_state = (*salvaged)->Snapshot(victim_key);
+  EXPECT_FALSE(lost_state && !lost_state->is_static) << "a changed model served from a damaged record";
+  got.erase(victim_key);
+  expected.erase(victim_key);
+  EXPECT_EQ(got, expected);
+  // The damaged map is untouched and still failed.
+  EXPECT_EQ(testing::ReadWholeFile(file), damaged);
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);
+  EXPECT_EQ((*store)->FailedMaps()[0].name, "m");
+  // A second salvage under the same name is refused: the first one's map is there.
+  EXPECT_TRUE(absl::IsAlreadyExists((*store)->SalvageMap("m", "").status()));
+
+  // The salvaged map is an ordinary map: it comes back at the next start.
+  ASSERT_TRUE((*store)->Close().ok());
+  store->reset();
+  auto reopened = Store::Open(dir.path(), {});
+  ASSERT_TRUE(reopened.ok());
+  auto again = (*reopened)->Map("m-salvaged");
+  ASSERT_TRUE(again.ok()) << again.status();
+  got = Fingerprints(**again);
+  got.erase(victim_key);
+  EXPECT_EQ(got, expected);
+}
+
+TEST(SalvageTest, AnLmdbAbortKeepsTheRecordsReadBeforeItAndTheOtherDatabases) {
+  TempDir dir;
+  std::map<uint64_t, std::string> want;
+  const MapInfo info = FilledMap(dir, want);
+  const std::string shard_dir = MapDir(dir, info.id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::vector<Record> dynamic = RecordsOf(shard_dir, "dynamic");
+  const size_t statics = RecordsOf(shard_dir, "static").size();
+  for (const size_t at : testing::FindAll(testing::ReadWholeFile(file), Bytes(dynamic[dynamic.size() / 2].value))) {
+    ASSERT_GT(at / 4096, 1u);  // never a meta page
+    testing::ZeroPage(file, at / 4096);
+  }
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok()) << store.status();
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);  // the probe found the page: LMDB would abort on it
+
+  auto report = (*store)->SalvageMap("m", "rescued");
+  ASSERT_TRUE(report.ok()) << report.status();
+  const SalvageDatabase& d = Db(*report, "dynamic");
+  // The scan died in the zeroed page: what came before it is kept, and LMDB's count says how much was not read.
+  EXPECT_GT(d.kept, 0u);
+  EXPECT_GT(d.lost, 0u);
+  EXPECT_EQ(d.kept + d.lost, dynamic.size());
+  EXPECT_EQ(Db(*report, "static").kept, statics);
+  EXPECT_EQ(Db(*report, "labels").kept + Db(*report, "labels").lost, kStates);
+  bool named = false;
+  for (const VerifyProblem& p : report->lost) {
+    named |= p.file == "shard-0/data.mdb" && p.what.find("LMDB aborted reading it (signal 6)") != std::string::npos;
+  }
+  EXPECT_TRUE(named) << "no loss names the abort";
+
+  // Exactly the first d.kept changed states (key order, as LMDB scans) survive; the others have no changed model.
+  auto map = (*store)->Map("rescued");
+  ASSERT_TRUE(map.ok()) << map.status();
+  const std::map<uint64_t, std::string> got = Fingerprints(**map);
+  for (size_t i = 0; i < dynamic.size(); ++i) {
+    const uint64_t key = KeyFromBytes(reinterpret_cast<const uint8_t*>(dynamic[i].key.data()));
+    const auto snapshot = (*map)->Snapshot(key);
+    if (i < d.kept) {
+      ASSERT_TRUE(snapshot && !snapshot->is_static) << "state " << key;
+      ASSERT_TRUE(got.contains(key));
+      EXPECT_EQ(got.at(key), want[key]) << "state " << key;
+    } else {
+      EXPECT_FALSE(snapshot && !snapshot->is_static) << "state " << key << " was past the abort";
+    }
+  }
+  // Never-changed states were in another database: all kept.
+  for (uint64_t k = 4; k <= kStates; k += 4) {
+    const auto snapshot = (*map)->Snapshot(k);
+    ASSERT_TRUE(snapshot && snapshot->is_static) << "state " << k;
+    ASSERT_TRUE(got.contains(k));
+    EXPECT_EQ(got.at(k), want[k]) << "state " << k;
+  }
+}
+
+// Returns the byte offset of the record with LSN `lsn` in a segment whose first record is `first`.
+uint64_t RecordOffset(const std::string& bytes, uint64_t first, uint64_t lsn) {
+  uint64_t offset = 0;
+  for (uint64_t l = first; l < lsn; ++l) {
+    const auto* p = reinterpret_cast<const uint8_t*>(bytes.data() + offset);
+    offset += 16 + (uint32_t{p[0]} | uint32_t{p[1]} << 8 | uint32_t{p[2]} << 16 | uint32_t{p[3]} << 24);
+  }
+  return offset;
+}
+
+TEST(SalvageTest, ACorruptLogRecordKeepsTheLogBeforeItAndReportsTheRest) {
+  TempDir dir, image;
+  StoreOptions no_checkpoints;
+  no_checkpoints.checkpoint_log_bytes = 1ull << 40;
+  uint64_t id = 0;
+  {
+    auto store = Store::Open(dir.path(), no_checkpoints);
+    ASSERT_TRUE(store.ok());
+    id = (*store)->CreateMap(Generic("m"))->id;
+    auto map = *(*store)->Map("m");
+    Fill(*map);  // LSNs 1..24, checkpointed
+    ASSERT_TRUE(map->Checkpoint().ok());
+    for (uint64_t i = 0; i < 20; ++i) {  // LSNs 25..44: only in the log
+      ObservationBatch b;
+      b.writer_id = 2;
+      b.sequence = i + 1;
+      b.time = 1.8e9 + 60.0 * i;
+      for (uint64_t k = 1; k <= 8; ++k) {
+        b.keys.push_back(k);
+        b.values.push_back(1.0f);
+      }
+      ASSERT_TRUE(map->Write(b).ok());
+    }
+    testing::CopyCrashImage(dir.path(), image.path());  // killed here
+  }
+  const std::string wal = MapDir(image, id) + "/wal";
+  std::vector<std::string> segments;
+  for (const auto& e : std::filesystem::directory_iterator(wal)) segments.push_back(e.path().string());
+  ASSERT_EQ(segments.size(), 1u);
+  const std::string segment = segments[0];
+  const std::string log = testing::ReadWholeFile(segment);
+  const uint64_t first = std::stoull(std::filesystem::path(segment).filename().string().substr(4, 20));
+  const uint64_t at = RecordOffset(log, first, 35);  // the record of LSN 35
+  testing::FlipBit(segment, at + 20, 0);             // in its payload
+
+  auto store = Store::Open(image.path(), {});
+  ASSERT_TRUE(store.ok());
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);
+  auto report = (*store)->SalvageMap("m", "");
+  ASSERT_TRUE(report.ok()) << report.status();
+  // The records after the checkpoint up to the damaged one: 25..34.
+  EXPECT_EQ(report->log.records_kept, 10u);
+  EXPECT_EQ(report->log.last_lsn, 34u);
+  EXPECT_EQ(report->log.records_lost, 10u);  // 35 (damaged) .. 44
+  EXPECT_EQ(report->log.bytes_lost, log.size() - at);
+  EXPECT_EQ(report->records_lost(), 0u);
+  ASSERT_EQ(report->lost.size(), 1u);
+  EXPECT_EQ(report->lost[0].file, "wal/" + std::filesystem::path(segment).filename().string());
+  EXPECT_EQ(report->lost[0].where, absl::StrCat("byte ", at, " (after LSN 34)"));
+
+  auto map = (*store)->Map("m-salvaged");
+  ASSERT_TRUE(map.ok()) << map.status();
+  // 24 scans of every state, then 10 of states 1..8.
+  EXPECT_EQ((*map)->Stats().totals.observations, 24 * kStates + 10 * 8);
+  // New records go above everything kept.
+  ObservationBatch b;
+  b.writer_id = 3;
+  b.sequence = 1;
+  b.time = 1.9e9;
+  b.keys = {1};
+  b.values = {0.0f};
+  auto ack = (*map)->Write(b);
+  ASSERT_TRUE(ack.ok()) << ack.status();
+  EXPECT_EQ(ack->lsn, 35u);
+  // The damaged log is left as it was.
+  std::string expected_log = log;
+  expected_log[at + 20] = static_cast<char>(expected_log[at + 20] ^ 1);
+  EXPECT_EQ(testing::ReadWholeFile(segment), expected_log);
+
+  // And the salvaged map recovers from its own log at the next start.
+  store->reset();
+  auto reopened = Store::Open(image.path(), {});
+  ASSERT_TRUE(reopened.ok());
+  auto again = (*reopened)->Map("m-salvaged");
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_EQ((*again)->Stats().totals.observations, 24 * kStates + 10 * 8 + 1);
+}
+
+}  // namespace
+}  // namespace fremen::storage
