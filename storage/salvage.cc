@@ -125,7 +125,7 @@ bool SendDatabase(int fd, const std::string& shard_dir, const std::string& db_na
 class ShardSalvager {
  public:
   ShardSalvager(const MapInfo& info, const model::ModelSettings& settings, uint32_t shard, SalvageReport& report)
-      : info_(info), shard_(shard), checks_(info, settings, shard), report_(report) {
+      : shard_(shard), checks_(info, settings, shard), report_(report) {
     shard_report_.shard = shard;
   }
 
@@ -385,7 +385,6 @@ class ShardSalvager {
     std::string db, key, value;
   };
 
-  const MapInfo& info_;
   const uint32_t shard_;
   const ShardRecordChecks checks_;
   SalvageReport& report_;
@@ -424,6 +423,8 @@ absl::Status SalvageLogRecords(const std::string& from_wal, const std::string& t
     return absl::OkStatus();
   };
   SalvageLog& log = report.log;
+  std::error_code error;
+  if (!fs::exists(from_wal, error)) return absl::OkStatus();  // no log: nothing to replay (and nothing lost)
   WalStop stop;
   auto replayed = ReplayWal(
       from_wal, after_lsn,
@@ -461,14 +462,15 @@ absl::Status SalvageLogRecords(const std::string& from_wal, const std::string& t
     if (replayed->truncated_tail) log.torn_tail_bytes = replayed->torn_tail_bytes;
     return absl::OkStatus();
   }
+  // Without a place (the log could not be listed or read) nothing of it is kept, and what is lost is unknown.
+  const bool placed = !stop.file.empty() && stop.lsn > 0;
   log.bytes_lost = stop.bytes_after;
-  log.records_lost = stop.highest_lsn_after >= stop.lsn ? stop.highest_lsn_after - stop.lsn + 1 : 1;
-  if (log.last_lsn == 0 && stop.lsn > 0) log.last_lsn = std::max(after_lsn, stop.lsn - 1);
+  log.records_lost = !placed ? 0 : stop.highest_lsn_after >= stop.lsn ? stop.highest_lsn_after - stop.lsn + 1 : 1;
+  if (log.last_lsn == 0 && placed) log.last_lsn = std::max(after_lsn, stop.lsn - 1);
   ++report.losses;
   if (report.lost.size() < kMaxListedLosses) {
-    const std::string file =
-        stop.file.empty() ? "wal" : absl::StrCat("wal/", fs::path(stop.file).filename().string());
-    report.lost.push_back({file, absl::StrCat("byte ", stop.offset, " (after LSN ", stop.lsn - 1, ")"),
+    const std::string file = placed ? absl::StrCat("wal/", fs::path(stop.file).filename().string()) : "wal";
+    report.lost.push_back({file, placed ? absl::StrCat("byte ", stop.offset, " (after LSN ", stop.lsn - 1, ")") : "",
                            absl::StrCat(replayed.status().message(), "; ", log.bytes_lost, " bytes (", log.records_lost,
                                         " records) from there on were lost")});
   }
