@@ -202,6 +202,68 @@ TEST(SalvageTest, AnLmdbAbortKeepsTheRecordsReadBeforeItAndTheOtherDatabases) {
   }
 }
 
+// A lossless map whose state lost its changed record: the state's lossless history goes with it (a history without its
+// state would not load), reported; every other state keeps its model and its history.
+TEST(SalvageTest, ALosslessHistoryWhoseStateWasLostIsDroppedAndReported) {
+  TempDir dir;
+  constexpr uint64_t kKeys = 16;
+  MapInfo info = Generic("m");
+  info.lossless_sampling_period = 60;
+  info.lossless_origin = 1.7e9;
+  std::map<uint64_t, StateSnapshot> want;
+  {
+    auto store = Store::Open(dir.path(), {});
+    ASSERT_TRUE(store.ok());
+    info = *(*store)->CreateMap(info);
+    auto map = *(*store)->Map("m");
+    for (uint64_t i = 0; i < 200; ++i) {
+      ObservationBatch b;
+      b.writer_id = 1;
+      b.sequence = i + 1;
+      b.time = 1.7e9 + 60.0 * i + 1;
+      for (uint64_t k = 1; k <= kKeys; ++k) {
+        b.keys.push_back(k);
+        b.values.push_back((i / (k + 2)) % 2 == 0 || i % (k + 5) == 0 ? 1.0f : 0.0f);
+      }
+      ASSERT_TRUE(map->Write(b).ok());
+    }
+    for (uint64_t k = 1; k <= kKeys; ++k) want[k] = *map->Snapshot(k);
+  }
+  const std::string shard_dir = MapDir(dir, info.id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::vector<Record> dynamic = RecordsOf(shard_dir, "dynamic");
+  ASSERT_EQ(dynamic.size(), kKeys);
+  ASSERT_EQ(RecordsOf(shard_dir, "lossless").size(), kKeys);
+  const uint64_t victim = 5;
+  for (const size_t at : testing::FindAll(testing::ReadWholeFile(file), Bytes(dynamic[victim - 1].value))) {
+    testing::FlipBit(file, at + 30, 1);
+  }
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok());
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);
+  auto report = (*store)->SalvageMap("m", "");
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_EQ(Db(*report, "dynamic").kept, kKeys - 1);
+  EXPECT_EQ(Db(*report, "dynamic").lost, 1u);
+  EXPECT_EQ(Db(*report, "lossless").kept, kKeys - 1);
+  EXPECT_EQ(Db(*report, "lossless").lost, 1u);
+  ASSERT_EQ(report->lost.size(), 2u);
+  EXPECT_EQ(report->lost[1].file, "shard-0/data.mdb");
+  EXPECT_EQ(report->lost[1].where, "lossless record of key 5");
+  EXPECT_EQ(report->lost[1].what, "a lossless history without its state (its record was lost)");
+  auto map = (*store)->Map("m-salvaged");
+  ASSERT_TRUE(map.ok()) << map.status();
+  for (uint64_t k = 1; k <= kKeys; ++k) {
+    const auto got = (*map)->Snapshot(k);
+    if (k == victim) {
+      EXPECT_FALSE(got && !got->is_static) << "a changed model served from a damaged record";
+      continue;
+    }
+    ASSERT_TRUE(got && got->model && got->lossless) << "state " << k;
+    EXPECT_EQ(model::EncodeStateModel(*got->model), model::EncodeStateModel(*want[k].model)) << "state " << k;
+    EXPECT_EQ(*got->lossless, *want[k].lossless) << "state " << k;
+  }
+}
+
 // Returns the byte offset of the record with LSN `lsn` in a segment whose first record is `first`.
 uint64_t RecordOffset(const std::string& bytes, uint64_t first, uint64_t lsn) {
   uint64_t offset = 0;
