@@ -12,6 +12,8 @@
 
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
+#include "storage/cell_key.h"
+#include "storage/shard_records.h"
 #include "storage/store.h"
 #include "storage/testing/crash_image.h"
 #include "storage/testing/file_damage.h"
@@ -274,31 +276,38 @@ uint64_t RecordOffset(const std::string& bytes, uint64_t first, uint64_t lsn) {
   return offset;
 }
 
-TEST(SalvageTest, ACorruptLogRecordKeepsTheLogBeforeItAndReportsTheRest) {
-  TempDir dir, image;
+// What `kill -9` leaves in `image` of a store in `dir` whose map "m" (of `shards` shards) was filled and checkpointed
+// (LSNs 1..24), then took `batches` more batches observing `keys` (LSNs 25..): those only in the log. Returns the map.
+MapInfo CrashedAfterCheckpoint(const TempDir& dir, const TempDir& image, uint32_t shards, uint64_t batches,
+                               uint64_t keys) {
   StoreOptions no_checkpoints;
   no_checkpoints.checkpoint_log_bytes = 1ull << 40;
-  uint64_t id = 0;
-  {
-    auto store = Store::Open(dir.path(), no_checkpoints);
-    ASSERT_TRUE(store.ok());
-    id = (*store)->CreateMap(Generic("m"))->id;
-    auto map = *(*store)->Map("m");
-    Fill(*map);  // LSNs 1..24, checkpointed
-    ASSERT_TRUE(map->Checkpoint().ok());
-    for (uint64_t i = 0; i < 20; ++i) {  // LSNs 25..44: only in the log
-      ObservationBatch b;
-      b.writer_id = 2;
-      b.sequence = i + 1;
-      b.time = 1.8e9 + 60.0 * i;
-      for (uint64_t k = 1; k <= 8; ++k) {
-        b.keys.push_back(k);
-        b.values.push_back(1.0f);
-      }
-      ASSERT_TRUE(map->Write(b).ok());
+  auto store = Store::Open(dir.path(), no_checkpoints);
+  EXPECT_TRUE(store.ok());
+  MapInfo info = Generic("m");
+  info.shards = shards;
+  info = *(*store)->CreateMap(info);
+  auto map = *(*store)->Map("m");
+  Fill(*map);
+  EXPECT_TRUE(map->Checkpoint().ok());
+  for (uint64_t i = 0; i < batches; ++i) {
+    ObservationBatch b;
+    b.writer_id = 2;
+    b.sequence = i + 1;
+    b.time = 1.8e9 + 60.0 * i;
+    for (uint64_t k = 1; k <= keys; ++k) {
+      b.keys.push_back(k);
+      b.values.push_back(1.0f);
     }
-    testing::CopyCrashImage(dir.path(), image.path());  // killed here
+    EXPECT_TRUE(map->Write(b).ok());
   }
+  testing::CopyCrashImage(dir.path(), image.path());  // killed here
+  return info;
+}
+
+TEST(SalvageTest, ACorruptLogRecordKeepsTheLogBeforeItAndReportsTheRest) {
+  TempDir dir, image;
+  const uint64_t id = CrashedAfterCheckpoint(dir, image, 1, 20, 8).id;  // LSNs 25..44 in the log only
   const std::string wal = MapDir(image, id) + "/wal";
   std::vector<std::string> segments;
   for (const auto& e : std::filesystem::directory_iterator(wal)) segments.push_back(e.path().string());
@@ -350,6 +359,53 @@ TEST(SalvageTest, ACorruptLogRecordKeepsTheLogBeforeItAndReportsTheRest) {
   auto again = (*reopened)->Map("m-salvaged");
   ASSERT_TRUE(again.ok()) << again.status();
   EXPECT_EQ((*again)->Stats().totals.observations, 24 * kStates + 10 * 8 + 1);
+}
+
+// A shard whose checkpoint LSN record was damaged: nothing says which log records it holds, so none is applied to it
+// again (its checkpoint is set to the end of the kept log), and that is reported; the other shard replays the log.
+TEST(SalvageTest, ALostCheckpointLsnAppliesNoLogRecordToItsShardTwice) {
+  TempDir dir, image;
+  const MapInfo info = CrashedAfterCheckpoint(dir, image, 2, 10, kStates);  // LSNs 25..34 in the log only
+  const std::string file = MapDir(image, info.id) + "/shard-1/data.mdb";
+  const std::string key = shard_records::kLsnKey;
+  const std::vector<size_t> copies = testing::FindAll(testing::ReadWholeFile(file), Bytes(key));
+  ASSERT_FALSE(copies.empty());
+  for (const size_t at : copies) testing::FlipBit(file, at + key.size() + 2, 5);  // in the value after the key
+
+  auto store = Store::Open(image.path(), {});
+  ASSERT_TRUE(store.ok());
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);
+  auto report = (*store)->SalvageMap("m", "");
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_EQ(report->log.records_kept, 10u);
+  EXPECT_EQ(report->log.last_lsn, 34u);
+  ASSERT_EQ(report->shards.size(), 2u);
+  EXPECT_EQ(report->shards[1].databases[5].name, "meta");
+  EXPECT_EQ(report->shards[1].databases[5].lost, 1u);
+  bool named = false;
+  for (const VerifyProblem& p : report->lost) {
+    named |= p.file == "shard-1/data.mdb" && p.where == "meta record checkpoint_lsn" &&
+             p.what == "the checkpoint LSN was lost; set to 34: no log record up to it is applied to this shard";
+  }
+  EXPECT_TRUE(named);
+  auto map = (*store)->Map("m-salvaged");
+  ASSERT_TRUE(map.ok()) << map.status();
+  uint64_t in_shard_0 = 0;
+  for (uint64_t k = 1; k <= kStates; ++k) in_shard_0 += ShardOf(k, 2) == 0;
+  ASSERT_GT(in_shard_0, 0u);
+  ASSERT_LT(in_shard_0, kStates);
+  // Shard 0: the 24 checkpointed scans and the 10 of the log; shard 1: the checkpointed ones only.
+  EXPECT_EQ((*map)->Stats().totals.observations, 24 * kStates + 10 * in_shard_0);
+  // New records go above the log kept.
+  ObservationBatch b;
+  b.writer_id = 3;
+  b.sequence = 1;
+  b.time = 1.9e9;
+  b.keys = {1};
+  b.values = {0.0f};
+  auto ack = (*map)->Write(b);
+  ASSERT_TRUE(ack.ok()) << ack.status();
+  EXPECT_EQ(ack->lsn, 35u);
 }
 
 }  // namespace
