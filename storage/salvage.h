@@ -10,7 +10,9 @@
 // invariants the loader relies on are restored: a lossless history or wide body whose state was
 // lost is dropped, a state stored both as never changed and as changed keeps its changed model,
 // the touched list names only surviving states (none survives its own loss: then every state counts
-// as touched, as in a shard that never had the list).
+// as touched, as in a shard that never had the list). A label that verifies is kept even when its
+// state's model was lost: the loader needs no state for it, and its name still names that state
+// (which then answers as unobserved).
 //
 // Log: the records up to the first damaged one (or the first that does not decode) are written to
 // the new map's wal/ under their own LSNs, so that the normal recovery replays them on top of the
