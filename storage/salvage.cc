@@ -548,7 +548,7 @@ namespace fremen::storage {
 
 absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const std::string& new_name) {
   const std::string target_name = new_name.empty() ? name + "-salvaged" : new_name;
-  std::lock_guard lock(mutex_);
+  std::unique_lock lock(mutex_);
   const auto failed = failed_.find(name);
   if (failed == failed_.end()) {
     if (maps_.contains(name)) {
@@ -562,6 +562,9 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
                                                       ": its catalog record is damaged, so nothing says what its files "
                                                       "hold or where they are; it cannot be salvaged"));
   }
+  if (salvaging_.contains(name)) {
+    return absl::FailedPreconditionError(absl::StrCat("map ", name, " is being salvaged already"));
+  }
   auto info = catalog_->Get(name);
   if (!info.ok()) return info.status();
   if (maps_.contains(target_name) || failed_.contains(target_name) || catalog_->Get(target_name).ok()) {
@@ -571,25 +574,38 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
   copy.name = target_name;
   auto created = catalog_->Create(copy, copy.shards, [this](uint64_t id) { return HasDirectory(id); });
   if (!created.ok()) return created.status();
+  // Both names are held (DeleteMap refuses them, Map answers Unavailable for the new one) while the files are read and
+  // written without the lock, so that the other maps serve meanwhile.
+  const std::string from_dir = failed->second.dir;
+  salvaging_.insert(name);
+  salvaging_.insert(target_name);
+  lock.unlock();
   // The id has no directory (Create skipped those that do): everything under `target` is this call's, and only that is
   // removed when the salvage fails.
   const std::string target = MapDir(created->id);
-  const auto undo = [&](const absl::Status& why) {
+  absl::StatusOr<SalvageReport> report;
+  std::error_code error;
+  fs::create_directories(target, error);
+  if (error) {
+    report = absl::InternalError(absl::StrCat("salvage of map ", name, ": ", target, ": ", error.message()));
+  } else {
+    report = SalvageFiles(from_dir, target, *created, options_);
+  }
+  lock.lock();
+  salvaging_.erase(name);
+  salvaging_.erase(target_name);
+  if (report.ok()) {
+    report->from = name;
+    if (auto map = OpenMap(*created); !map.ok()) {
+      report = absl::Status(map.status().code(), absl::StrCat("salvage of map ", name,
+                                                              ": the salvaged copy did not open, and was removed: ",
+                                                              map.status().message()));
+    }
+  }
+  if (!report.ok()) {
     (void)catalog_->Delete(created->name);
     std::error_code ignored;
     fs::remove_all(target, ignored);
-    return why;
-  };
-  std::error_code error;
-  fs::create_directories(target, error);
-  if (error) return undo(absl::InternalError(absl::StrCat("salvage of map ", name, ": ", target, ": ", error.message())));
-  auto report = SalvageFiles(failed->second.dir, target, *created, options_);
-  if (!report.ok()) return undo(report.status());
-  report->from = name;
-  if (auto map = OpenMap(*created); !map.ok()) {
-    return undo(absl::Status(map.status().code(), absl::StrCat("salvage of map ", name, ": the salvaged copy did not "
-                                                               "open, and was removed: ",
-                                                               map.status().message())));
   }
   return report;
 }
