@@ -175,6 +175,26 @@ TEST_F(CheckTest, AReadTokenIsEnoughToCheck) {
       grpc::StatusCode::NOT_FOUND);
 }
 
+TEST_F(CheckTest, SalvageNeedsAWriteToken) {
+  StopDaemon();
+  Start({"--tokens-file", dir_.Write("tokens", "read:reader-token\nwrite:writer-token\n")});
+  v1::SalvageMapRequest request;
+  request.set_map("nothing");
+  v1::SalvageMapResponse response;
+  EXPECT_EQ(
+      admin_->SalvageMap(CallContext({{"authorization", "Bearer reader-token"}}).get(), request, &response).error_code(),
+      grpc::StatusCode::PERMISSION_DENIED);
+  // Past authorization with the write token: the map is looked up (and does not exist).
+  const grpc::Status status =
+      admin_->SalvageMap(CallContext({{"authorization", "Bearer writer-token"}}).get(), request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("nothing"));
+  request.clear_map();
+  EXPECT_EQ(
+      admin_->SalvageMap(CallContext({{"authorization", "Bearer writer-token"}}).get(), request, &response).error_code(),
+      grpc::StatusCode::INVALID_ARGUMENT);
+}
+
 TEST_F(CheckTest, FremendVerifyOfAStoppedDataDirectory) {
   MakeGrid("lab", 64, 32, 6);
   // Refused while the daemon holds the data directory.
