@@ -13,7 +13,9 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "storage/cell_key.h"
+#include "storage/lmdb/lmdb_env.h"
 #include "storage/shard_records.h"
+#include "storage/static_bricks.h"
 #include "storage/store.h"
 #include "storage/testing/crash_image.h"
 #include "storage/testing/file_damage.h"
@@ -131,6 +133,8 @@ TEST(SalvageTest, AFlippedBitLosesThatRecordAndKeepsEveryOther) {
   got.erase(victim_key);
   expected.erase(victim_key);
   EXPECT_EQ(got, expected);
+  const VerifyReport verified = (*salvaged)->Verify();
+  EXPECT_TRUE(verified.clean()) << (verified.problems.empty() ? "" : FormatProblem(verified.problems[0]));
   // The damaged map is untouched and still failed.
   EXPECT_EQ(testing::ReadWholeFile(file), damaged);
   ASSERT_EQ((*store)->FailedMaps().size(), 1u);
@@ -202,6 +206,74 @@ TEST(SalvageTest, AnLmdbAbortKeepsTheRecordsReadBeforeItAndTheOtherDatabases) {
     ASSERT_TRUE(got.contains(k));
     EXPECT_EQ(got.at(k), want[k]) << "state " << k;
   }
+}
+
+// A state stored both as never changed and as changed (the verifier's "also stored as never changed") in a map failed
+// by another damaged record: the changed model is kept, the never-changed copy dropped and reported.
+TEST(SalvageTest, AStateStoredBothAsNeverChangedAndChangedKeepsItsChangedModel) {
+  TempDir dir;
+  std::map<uint64_t, std::string> want;
+  const MapInfo info = FilledMap(dir, want);
+  const std::string shard_dir = MapDir(dir, info.id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::vector<Record> dynamic = RecordsOf(shard_dir, "dynamic");
+  const size_t statics = RecordsOf(shard_dir, "static").size();
+  {
+    // Brick 0 gains a never-changed copy of state 1 (a changed state: 1 % 4 != 0).
+    LmdbOptions options;
+    options.databases = shard_records::AllDatabases();
+    auto env = LmdbEnv::Open(shard_dir, options);
+    ASSERT_TRUE(env.ok()) << env.status();
+    ASSERT_TRUE((*env)
+                    ->Write([&](LmdbTxn& txn) -> absl::Status {
+                      const auto key = KeyBytes(0);
+                      auto stored = txn.Get(*txn.Db(shard_records::kStaticDb), key);
+                      if (!stored.ok()) return stored.status();
+                      auto brick = StaticBrick::Decode(
+                          std::string_view(reinterpret_cast<const char*>(stored->data()), stored->size()));
+                      if (!brick.ok()) return brick.status();
+                      StaticBrick twisted;
+                      bool added = false;
+                      brick->ForEach([&](uint32_t i, const model::StaticState& state) {
+                        if (!added && i > 1) {
+                          twisted.Add(1, state);
+                          added = true;
+                        }
+                        twisted.Add(i, state);
+                      });
+                      return txn.Put(*txn.Db(shard_records::kStaticDb), key, Bytes(twisted.Encode()));
+                    })
+                    .ok());
+  }
+  // And another state's record is damaged, so that the map fails to open.
+  const Record& victim = dynamic[1];
+  const uint64_t victim_key = KeyFromBytes(reinterpret_cast<const uint8_t*>(victim.key.data()));
+  ASSERT_NE(victim_key, 1u);
+  for (const size_t at : testing::FindAll(testing::ReadWholeFile(file), Bytes(victim.value))) {
+    testing::FlipBit(file, at + 7, 2);
+  }
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok());
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);
+  auto report = (*store)->SalvageMap("m", "");
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_EQ(Db(*report, "static").kept, statics);
+  EXPECT_EQ(Db(*report, "dynamic").kept, dynamic.size() - 1);
+  EXPECT_EQ(report->losses, 2u);
+  bool named = false;
+  for (const VerifyProblem& p : report->lost) {
+    named |= p.where == "static record of key 0" &&
+             p.what == "state 1 is also stored as changed: its never-changed copy was dropped";
+  }
+  EXPECT_TRUE(named);
+  auto map = (*store)->Map("m-salvaged");
+  ASSERT_TRUE(map.ok()) << map.status();
+  std::map<uint64_t, std::string> got = Fingerprints(**map);
+  got.erase(victim_key);
+  want.erase(victim_key);
+  EXPECT_EQ(got, want);  // state 1 too: its changed model
+  // And the new map's files verify clean: the never-changed copy is gone from them.
+  const VerifyReport verified = (*map)->Verify();
+  EXPECT_TRUE(verified.clean()) << (verified.problems.empty() ? "" : FormatProblem(verified.problems[0]));
 }
 
 // A lossless map whose state lost its changed record: the state's lossless history goes with it (a history without its
