@@ -3,9 +3,9 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <map>
-#include <cstring>
 #include <mutex>
 #include <optional>
 
@@ -141,7 +141,8 @@ class ShardSalvager {
     for (const std::string& db : sr::AllDatabases()) shard_report_.databases.push_back({db, 0, 0});
     // The meta records first: the checkpoint LSN decides what the log replays, and the touched
     // list is filtered by the states that survive.
-    for (const std::string db : {sr::kMetaDb, sr::kStaticDb, sr::kDynamicDb, sr::kLosslessDb, sr::kWideDb, sr::kLabelsDb}) {
+    for (const std::string db :
+         {sr::kMetaDb, sr::kStaticDb, sr::kDynamicDb, sr::kLosslessDb, sr::kWideDb, sr::kLabelsDb}) {
       ReadDatabase(from_dir, db);
       if (!write_error_.ok()) return write_error_;
       if (db == sr::kDynamicDb) WriteStatic();
@@ -248,7 +249,8 @@ class ShardSalvager {
                               size_t pos = 0;
                               while (buffer.size() - pos >= 4) {
                                 uint32_t n = 0;
-                                for (int i = 0; i < 4; ++i) n |= uint32_t{static_cast<uint8_t>(buffer[pos + i])} << (8 * i);
+                                for (int i = 0; i < 4; ++i)
+                                  n |= uint32_t{static_cast<uint8_t>(buffer[pos + i])} << (8 * i);
                                 if (buffer.size() - pos - 4 < n) break;
                                 on_frame(std::string_view(buffer).substr(pos + 4, n));
                                 pos += 4 + n;
@@ -313,7 +315,8 @@ class ShardSalvager {
   }
 
   void TakeMeta(std::string_view name, std::string_view value) {
-    const std::string where = absl::StrCat("meta record ", absl::CHexEscape(absl::string_view(name.data(), name.size())));
+    const std::string where =
+        absl::StrCat("meta record ", absl::CHexEscape(absl::string_view(name.data(), name.size())));
     if (name == sr::kLsnKey) {
       had_lsn_record_ = true;
       auto lsn = sr::DecodeCheckpointLsn(Bytes(value));
@@ -347,9 +350,9 @@ class ShardSalvager {
         if (dynamic_keys_.contains(key)) {
           ++report_.losses;
           if (report_.lost.size() < kMaxListedLosses) {
-            report_.lost.push_back({ShardFile(shard_), absl::StrCat("static record of key ", brick_key),
-                                    absl::StrCat("state ", key,
-                                                 " is also stored as changed: its never-changed copy was dropped")});
+            report_.lost.push_back(
+                {ShardFile(shard_), absl::StrCat("static record of key ", brick_key),
+                 absl::StrCat("state ", key, " is also stored as changed: its never-changed copy was dropped")});
           }
           return;
         }
@@ -400,7 +403,6 @@ class ShardSalvager {
   bool lsn_lost_ = false;
   std::optional<std::vector<uint64_t>> touched_;
   std::vector<std::pair<std::string, std::string>> other_meta_;
-
 };
 
 // Copies the intact prefix of the damaged log into `to_wal`, under the same LSNs.
@@ -479,8 +481,8 @@ absl::Status SalvageLogRecords(const std::string& from_wal, const std::string& t
 
 }  // namespace
 
-absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const std::string& to_dir,
-                                           const MapInfo& info, const StoreOptions& options) {
+absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const std::string& to_dir, const MapInfo& info,
+                                           const StoreOptions& options) {
   auto settings = ModelSettingsOf(info);
   if (!settings.ok()) return settings.status();
   SalvageReport report;
@@ -526,16 +528,16 @@ absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const st
       // The records this shard lacks up to the newest checkpoint are gone with the log's tail.
       ++report.losses;
       if (report.lost.size() < kMaxListedLosses) {
-        report.lost.push_back({ShardFile(i), "meta record checkpoint_lsn",
-                               absl::StrCat("checkpoint LSN raised from ", settled, " to ", floor,
-                                            ": the log ends at LSN ", log_end, ", so records ", settled + 1, "..",
-                                            floor, " are not applied to this shard")});
+        report.lost.push_back(
+            {ShardFile(i), "meta record checkpoint_lsn",
+             absl::StrCat("checkpoint LSN raised from ", settled, " to ", floor, ": the log ends at LSN ", log_end,
+                          ", so records ", settled + 1, "..", floor, " are not applied to this shard")});
       }
       settled = floor;
     }
     if (absl::Status s = shards[i]->WriteMeta(settled); !s.ok()) {
-      return absl::Status(s.code(), absl::StrCat("salvage of map ", info.name, " into ", to_dir, "/shard-", i, ": ",
-                                                 s.message()));
+      return absl::Status(
+          s.code(), absl::StrCat("salvage of map ", info.name, " into ", to_dir, "/shard-", i, ": ", s.message()));
     }
     report.shards.push_back(shards[i]->report());
   }
@@ -597,9 +599,10 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
   if (report.ok()) {
     report->from = name;
     if (auto map = OpenMap(*created); !map.ok()) {
-      report = absl::Status(map.status().code(), absl::StrCat("salvage of map ", name,
-                                                              ": the salvaged copy did not open, and was removed: ",
-                                                              map.status().message()));
+      report =
+          absl::Status(map.status().code(),
+                       absl::StrCat("salvage of map ", name,
+                                    ": the salvaged copy did not open, and was removed: ", map.status().message()));
     }
   }
   if (!report.ok()) {

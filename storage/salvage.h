@@ -53,11 +53,11 @@ struct SalvageShard {
 };
 
 struct SalvageLog {
-  uint64_t records_kept = 0;  // records copied into the new map's log
-  uint64_t bytes_kept = 0;    // their bytes, headers included
-  uint64_t last_lsn = 0;      // the last record kept; 0 when none
-  uint64_t records_lost = 0;  // after the first damaged record: it and every later intact one found
-  uint64_t bytes_lost = 0;    // from the first damaged record to the end of the log
+  uint64_t records_kept = 0;     // records copied into the new map's log
+  uint64_t bytes_kept = 0;       // their bytes, headers included
+  uint64_t last_lsn = 0;         // the last record kept; 0 when none
+  uint64_t records_lost = 0;     // after the first damaged record: it and every later intact one found
+  uint64_t bytes_lost = 0;       // from the first damaged record to the end of the log
   uint64_t torn_tail_bytes = 0;  // an incomplete last record (never acknowledged): not a loss
 };
 
@@ -68,7 +68,7 @@ struct SalvageReport {
   SalvageLog log;
   // What was lost and why, file/where/what as the verifier says it; the first kMaxListedLosses.
   std::vector<VerifyProblem> lost;
-  uint64_t losses = 0;  // all of them, listed or not
+  uint64_t losses = 0;            // all of them, listed or not
   uint64_t records_kept() const;  // of every shard
   uint64_t records_lost() const;
 };
@@ -76,7 +76,7 @@ struct SalvageReport {
 // Writes into `to_dir` (shard-N/, wal/; created) everything of the map in `from_dir` that verifies,
 // as `info` describes the map. Errors only for what prevents the salvage itself (the new files
 // cannot be written, the map's settings are invalid); damage is the report's.
-absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const std::string& to_dir,
-                                           const MapInfo& info, const StoreOptions& options);
+absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const std::string& to_dir, const MapInfo& info,
+                                           const StoreOptions& options);
 
 }  // namespace fremen::storage

@@ -348,6 +348,19 @@ uint64_t RecordOffset(const std::string& bytes, uint64_t first, uint64_t lsn) {
   return offset;
 }
 
+// A new batch written to the map is acknowledged with LSN `lsn`.
+void ExpectNextLsn(MapStore& map, uint64_t lsn) {
+  ObservationBatch b;
+  b.writer_id = 3;
+  b.sequence = 1;
+  b.time = 1.9e9;
+  b.keys = {1};
+  b.values = {0.0f};
+  auto ack = map.Write(b);
+  ASSERT_TRUE(ack.ok()) << ack.status();
+  EXPECT_EQ(ack->lsn, lsn);
+}
+
 // What `kill -9` leaves in `image` of a store in `dir` whose map "m" (of `shards` shards) was filled and checkpointed
 // (LSNs 1..24), then took `batches` more batches observing `keys` (LSNs 25..): those only in the log. Returns the map.
 MapInfo CrashedAfterCheckpoint(const TempDir& dir, const TempDir& image, uint32_t shards, uint64_t batches,
@@ -410,15 +423,7 @@ TEST(SalvageTest, ACorruptLogRecordKeepsTheLogBeforeItAndReportsTheRest) {
   // 24 scans of every state, then 10 of states 1..8.
   EXPECT_EQ((*map)->Stats().totals.observations, 24 * kStates + 10 * 8);
   // New records go above everything kept.
-  ObservationBatch b;
-  b.writer_id = 3;
-  b.sequence = 1;
-  b.time = 1.9e9;
-  b.keys = {1};
-  b.values = {0.0f};
-  auto ack = (*map)->Write(b);
-  ASSERT_TRUE(ack.ok()) << ack.status();
-  EXPECT_EQ(ack->lsn, 35u);
+  ExpectNextLsn(**map, 35);
   // The damaged log is left as it was.
   std::string expected_log = log;
   expected_log[at + 20] = static_cast<char>(expected_log[at + 20] ^ 1);
@@ -469,15 +474,7 @@ TEST(SalvageTest, ALostCheckpointLsnAppliesNoLogRecordToItsShardTwice) {
   // Shard 0: the 24 checkpointed scans and the 10 of the log; shard 1: the checkpointed ones only.
   EXPECT_EQ((*map)->Stats().totals.observations, 24 * kStates + 10 * in_shard_0);
   // New records go above the log kept.
-  ObservationBatch b;
-  b.writer_id = 3;
-  b.sequence = 1;
-  b.time = 1.9e9;
-  b.keys = {1};
-  b.values = {0.0f};
-  auto ack = (*map)->Write(b);
-  ASSERT_TRUE(ack.ok()) << ack.status();
-  EXPECT_EQ(ack->lsn, 35u);
+  ExpectNextLsn(**map, 35);
 }
 
 }  // namespace

@@ -144,7 +144,9 @@ absl::StatusOr<std::shared_ptr<MapStore>> Store::Map(const std::string& name) co
   std::lock_guard lock(mutex_);
   if (auto it = maps_.find(name); it != maps_.end()) return it->second;
   if (auto it = failed_.find(name); it != failed_.end()) return it->second.status;
-  if (salvaging_.contains(name)) return absl::UnavailableError(absl::StrCat("map \"", name, "\" is being salvaged into"));
+  if (salvaging_.contains(name)) {
+    return absl::UnavailableError(absl::StrCat("map \"", name, "\" is being salvaged into"));
+  }
   return absl::NotFoundError(absl::StrCat("no map named \"", name, "\""));
 }
 

@@ -63,10 +63,10 @@ class Store {
 
   // A new map `new_name` (empty: name + "-salvaged") holding everything of the failed map `name` that verifies, served
   // once it opens like any other (storage/salvage.h); the failed map and its files are left as they are. NotFound for
-  // an unknown map, FailedPrecondition for one that is not failed (it is copied with BackupMap/RestoreMap), AlreadyExists
-  // when new_name is taken. When the copy does not open, only the directory this call made is removed. The files are
-  // read and written without holding the store's lock (the other maps serve meanwhile); until the call returns, both
-  // maps refuse DeleteMap and Map(new_name) answers Unavailable.
+  // an unknown map, FailedPrecondition for one that is not failed (it is copied with BackupMap/RestoreMap),
+  // AlreadyExists when new_name is taken. When the copy does not open, only the directory this call made is removed.
+  // The files are read and written without holding the store's lock (the other maps serve meanwhile); until the call
+  // returns, both maps refuse DeleteMap and Map(new_name) answers Unavailable.
   absl::StatusOr<SalvageReport> SalvageMap(const std::string& name, const std::string& new_name);
 
   // Maps that did not open at Open, in name order.

@@ -181,18 +181,18 @@ TEST_F(CheckTest, SalvageNeedsAWriteToken) {
   v1::SalvageMapRequest request;
   request.set_map("nothing");
   v1::SalvageMapResponse response;
-  EXPECT_EQ(
-      admin_->SalvageMap(CallContext({{"authorization", "Bearer reader-token"}}).get(), request, &response).error_code(),
-      grpc::StatusCode::PERMISSION_DENIED);
+  const grpc::Status reader =
+      admin_->SalvageMap(CallContext({{"authorization", "Bearer reader-token"}}).get(), request, &response);
+  EXPECT_EQ(reader.error_code(), grpc::StatusCode::PERMISSION_DENIED) << reader.error_message();
   // Past authorization with the write token: the map is looked up (and does not exist).
   const grpc::Status status =
       admin_->SalvageMap(CallContext({{"authorization", "Bearer writer-token"}}).get(), request, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND) << status.error_message();
   EXPECT_THAT(status.error_message(), HasSubstr("nothing"));
   request.clear_map();
-  EXPECT_EQ(
-      admin_->SalvageMap(CallContext({{"authorization", "Bearer writer-token"}}).get(), request, &response).error_code(),
-      grpc::StatusCode::INVALID_ARGUMENT);
+  const grpc::Status unnamed =
+      admin_->SalvageMap(CallContext({{"authorization", "Bearer writer-token"}}).get(), request, &response);
+  EXPECT_EQ(unnamed.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << unnamed.error_message();
 }
 
 TEST_F(CheckTest, FremendVerifyOfAStoppedDataDirectory) {

@@ -32,9 +32,11 @@ void PrintReport(const std::string& from, const v1::SalvageMapResponse& r) {
     std::vector<std::string> parts;
     for (const v1::DatabaseSalvage& d : s.databases()) {
       if (d.kept() == 0 && d.lost() == 0) continue;
-      parts.push_back(absl::StrCat(d.name(), " ", d.kept(), " kept", d.lost() > 0 ? absl::StrCat(" ", d.lost(), " lost") : ""));
+      parts.push_back(
+          absl::StrCat(d.name(), " ", d.kept(), " kept", d.lost() > 0 ? absl::StrCat(" ", d.lost(), " lost") : ""));
     }
-    std::printf("map %s: shard-%u: %s\n", from.c_str(), s.shard(), parts.empty() ? "empty" : absl::StrJoin(parts, ", ").c_str());
+    std::printf("map %s: shard-%u: %s\n", from.c_str(), s.shard(),
+                parts.empty() ? "empty" : absl::StrJoin(parts, ", ").c_str());
   }
   std::printf(
       "map %s salvaged as %s: %llu records kept, %llu lost; log %llu records kept, %llu lost (%s); %llu losses; in "

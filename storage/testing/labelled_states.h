@@ -89,6 +89,8 @@ inline std::vector<Record> ShardRecords(const std::string& shard_dir) {
   return records;
 }
 
-inline std::span<const uint8_t> Bytes(const std::string& s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
+inline std::span<const uint8_t> Bytes(const std::string& s) {
+  return {reinterpret_cast<const uint8_t*>(s.data()), s.size()};
+}
 
 }  // namespace fremen::storage::testing

@@ -211,8 +211,8 @@ absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after
     if (!data.ok()) return data.status();
     uint64_t position = 0;
     auto scan = ScanSegment(path, Bytes(*data), expected, after_lsn, f, result.records, position);
-    const bool stopped = !scan.ok() || scan->end == SegmentScan::End::kCorrupt ||
-                         (scan->end == SegmentScan::End::kTornTail && !last);
+    const bool stopped =
+        !scan.ok() || scan->end == SegmentScan::End::kCorrupt || (scan->end == SegmentScan::End::kTornTail && !last);
     if (stopped && stop != nullptr) {
       *stop = WalStop{path, position, expected, 0, 0};
       MeasureRest(env, dir, *firsts, i, position, expected, *stop);

@@ -62,10 +62,10 @@ struct WalReplayResult {
 // refused by the callback, or the start of a segment after a gap), for a salvage that keeps the log
 // before it (storage/salvage.h).
 struct WalStop {
-  std::string file;               // the segment's path
-  uint64_t offset = 0;            // the record's byte offset in it
-  uint64_t lsn = 0;               // the LSN expected there
-  uint64_t bytes_after = 0;       // from there to the end of the log, later segments included
+  std::string file;                // the segment's path
+  uint64_t offset = 0;             // the record's byte offset in it
+  uint64_t lsn = 0;                // the LSN expected there
+  uint64_t bytes_after = 0;        // from there to the end of the log, later segments included
   uint64_t highest_lsn_after = 0;  // the highest LSN of an intact record found after it; 0: none
 };
 
