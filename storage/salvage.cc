@@ -11,6 +11,7 @@
 
 #include "absl/container/flat_hash_set.h"
 #include "absl/strings/escaping.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "storage/batch.h"
 #include "storage/cell_key.h"
@@ -221,7 +222,7 @@ class ShardSalvager {
       if (!r.Finish().ok()) return;
       switch (tag) {
         case kCount:
-          count = std::stoull(std::string(a));
+          if (uint64_t n = 0; absl::SimpleAtoi(absl::string_view(a.data(), a.size()), &n)) count = n;
           break;
         case kRecord:
           ++received;
@@ -258,7 +259,8 @@ class ShardSalvager {
                               buffer.erase(0, pos);
                             });
     Flush();
-    // Meta keys are in order: once one after "checkpoint_lsn" arrived, the LSN's fate is known.
+    // The LSN's record was not among those read before the meta database stopped, or (below) a damaged record whose
+    // key may have been it: what the shard holds of the log is unknown.
     if (db == sr::kMetaDb && !ended && !had_lsn_record_) lsn_lost_ = true;
     if (db == sr::kMetaDb && ended && !had_lsn_record_ && Counts(db).lost > 0) lsn_lost_ = true;
     if (!exit.ok()) {
