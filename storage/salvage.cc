@@ -495,7 +495,7 @@ absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const st
   for (uint32_t i = 0; i < info.shards; ++i) {
     shards.push_back(std::make_unique<ShardSalvager>(info, *settings, i, report));
     if (absl::Status s = shards.back()->Run(from_dir, absl::StrCat(to_dir, "/shard-", i)); !s.ok()) {
-      return absl::Status(s.code(), absl::StrCat("salvage of map ", info.name, " into ", to_dir, ": ", s.message()));
+      return absl::Status(s.code(), absl::StrCat(to_dir, "/shard-", i, ": ", s.message()));
     }
   }
   // The log replays after the oldest checkpoint that is known.
@@ -508,7 +508,7 @@ absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const st
   }
   if (absl::Status s = SalvageLogRecords(from_dir + "/wal", to_dir + "/wal", oldest.value_or(0), options, report);
       !s.ok()) {
-    return absl::Status(s.code(), absl::StrCat("salvage of map ", info.name, " into ", to_dir, "/wal: ", s.message()));
+    return absl::Status(s.code(), absl::StrCat(to_dir, "/wal: ", s.message()));
   }
   const uint64_t log_end = report.log.last_lsn;
   // A shard whose checkpoint was lost may hold any record of the log: none is applied to it again.
@@ -539,7 +539,7 @@ absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const st
     }
     if (absl::Status s = shards[i]->WriteMeta(settled); !s.ok()) {
       return absl::Status(
-          s.code(), absl::StrCat("salvage of map ", info.name, " into ", to_dir, "/shard-", i, ": ", s.message()));
+          s.code(), absl::StrCat(to_dir, "/shard-", i, ": ", s.message()));
     }
     report.shards.push_back(shards[i]->report());
   }
@@ -591,7 +591,7 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
   std::error_code error;
   fs::create_directories(target, error);
   if (error) {
-    report = absl::InternalError(absl::StrCat("salvage of map ", name, ": ", target, ": ", error.message()));
+    report = absl::InternalError(absl::StrCat(target, ": ", error.message()));
   } else {
     report = SalvageFiles(from_dir, target, *created, options_);
   }
@@ -601,13 +601,13 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
   if (report.ok()) {
     report->from = name;
     if (auto map = OpenMap(*created); !map.ok()) {
-      report =
-          absl::Status(map.status().code(),
-                       absl::StrCat("salvage of map ", name,
-                                    ": the salvaged copy did not open, and was removed: ", map.status().message()));
+      report = absl::Status(map.status().code(),
+                            absl::StrCat("the salvaged copy did not open, and was removed: ", map.status().message()));
     }
   }
   if (!report.ok()) {
+    report = absl::Status(report.status().code(), absl::StrCat("salvage of map ", name, " into ", target_name, ": ",
+                                                               report.status().message()));
     (void)catalog_->Delete(created->name);
     std::error_code ignored;
     fs::remove_all(target, ignored);

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -13,6 +14,7 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "storage/cell_key.h"
+#include "storage/env/fault_injection_env.h"
 #include "storage/lmdb/lmdb_env.h"
 #include "storage/shard_records.h"
 #include "storage/static_bricks.h"
@@ -390,18 +392,28 @@ MapInfo CrashedAfterCheckpoint(const TempDir& dir, const TempDir& image, uint32_
   return info;
 }
 
+// The only segment of a log directory.
+std::string OnlySegment(const std::string& wal) {
+  std::vector<std::string> segments;
+  for (const auto& e : std::filesystem::directory_iterator(wal)) segments.push_back(e.path().string());
+  EXPECT_EQ(segments.size(), 1u);
+  return segments.empty() ? "" : segments[0];
+}
+
+// Flips a bit in the payload of the record of LSN `lsn` of a segment; returns the record's offset.
+uint64_t DamageLogRecord(const std::string& segment, uint64_t lsn) {
+  const uint64_t first = std::stoull(std::filesystem::path(segment).filename().string().substr(4, 20));
+  const uint64_t at = RecordOffset(testing::ReadWholeFile(segment), first, lsn);
+  testing::FlipBit(segment, at + 20, 0);
+  return at;
+}
+
 TEST(SalvageTest, ACorruptLogRecordKeepsTheLogBeforeItAndReportsTheRest) {
   TempDir dir, image;
   const uint64_t id = CrashedAfterCheckpoint(dir, image, 1, 20, 8).id;  // LSNs 25..44 in the log only
-  const std::string wal = MapDir(image, id) + "/wal";
-  std::vector<std::string> segments;
-  for (const auto& e : std::filesystem::directory_iterator(wal)) segments.push_back(e.path().string());
-  ASSERT_EQ(segments.size(), 1u);
-  const std::string segment = segments[0];
+  const std::string segment = OnlySegment(MapDir(image, id) + "/wal");
   const std::string log = testing::ReadWholeFile(segment);
-  const uint64_t first = std::stoull(std::filesystem::path(segment).filename().string().substr(4, 20));
-  const uint64_t at = RecordOffset(log, first, 35);  // the record of LSN 35
-  testing::FlipBit(segment, at + 20, 0);             // in its payload
+  const uint64_t at = DamageLogRecord(segment, 35);
 
   auto store = Store::Open(image.path(), {});
   ASSERT_TRUE(store.ok());
@@ -475,6 +487,36 @@ TEST(SalvageTest, ALostCheckpointLsnAppliesNoLogRecordToItsShardTwice) {
   EXPECT_EQ((*map)->Stats().totals.observations, 24 * kStates + 10 * in_shard_0);
   // New records go above the log kept.
   ExpectNextLsn(**map, 35);
+}
+
+// A salvage that cannot write the new map's files (a full disk) fails naming the map and leaves nothing of the new map:
+// no catalog record, no directory. The damaged map stays failed, and a later salvage succeeds.
+TEST(SalvageTest, ASalvageThatCannotWriteLeavesNothingBehind) {
+  TempDir dir, image;
+  const uint64_t id = CrashedAfterCheckpoint(dir, image, 1, 20, 8).id;
+  DamageLogRecord(OnlySegment(MapDir(image, id) + "/wal"), 35);
+  FaultInjectionEnv env;
+  StoreOptions options;
+  options.env = &env;
+  auto store = Store::Open(image.path(), options);
+  ASSERT_TRUE(store.ok());
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);
+  env.FailWrites(ENOSPC);
+  auto refused = (*store)->SalvageMap("m", "");
+  ASSERT_FALSE(refused.ok());
+  EXPECT_TRUE(absl::IsResourceExhausted(refused.status())) << refused.status();
+  EXPECT_NE(refused.status().message().find("salvage of map m into m-salvaged: "), std::string::npos) << refused.status();
+  EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("m-salvaged").status()));
+  EXPECT_TRUE(absl::IsNotFound((*store)->Map("m-salvaged").status()));
+  std::vector<std::string> dirs;
+  for (const auto& e : std::filesystem::directory_iterator(image.path() + "/maps")) dirs.push_back(e.path().string());
+  EXPECT_EQ(dirs, std::vector<std::string>{MapDir(image, id)});
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);
+  env.FailWrites(0);
+  auto report = (*store)->SalvageMap("m", "");
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_EQ(report->log.records_kept, 10u);
+  EXPECT_TRUE((*store)->Map("m-salvaged").ok());
 }
 
 }  // namespace
