@@ -505,7 +505,8 @@ TEST(SalvageTest, ASalvageThatCannotWriteLeavesNothingBehind) {
   auto refused = (*store)->SalvageMap("m", "");
   ASSERT_FALSE(refused.ok());
   EXPECT_TRUE(absl::IsResourceExhausted(refused.status())) << refused.status();
-  EXPECT_NE(refused.status().message().find("salvage of map m into m-salvaged: "), std::string::npos) << refused.status();
+  EXPECT_NE(refused.status().message().find("salvage of map m into m-salvaged: "), std::string::npos)
+      << refused.status();
   EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("m-salvaged").status()));
   EXPECT_TRUE(absl::IsNotFound((*store)->Map("m-salvaged").status()));
   std::vector<std::string> dirs;
