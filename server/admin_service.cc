@@ -32,6 +32,7 @@ constexpr MethodSpec kBackupMap{"BackupMap", Access::kWrite, /*blocking=*/true};
 constexpr MethodSpec kRestoreMap{"RestoreMap", Access::kWrite, /*blocking=*/true};
 constexpr MethodSpec kGetServerStatus{"GetServerStatus", Access::kRead, /*blocking=*/true};
 constexpr MethodSpec kCheckMap{"CheckMap", Access::kRead, /*blocking=*/true};
+constexpr MethodSpec kSalvageMap{"SalvageMap", Access::kWrite, /*blocking=*/true};
 
 constexpr char kOperationPrefix[] = "operations/";
 
@@ -45,10 +46,10 @@ absl::StatusOr<std::string> OptionalMapName(const grpc::ServerContextBase& conte
   return ResolveMapName(context, request_map, field);
 }
 
-// Storage names the map "name"; the restore request calls it "map".
-absl::Status RenameRestoreFields(const absl::Status& status) {
+// Storage names the new map "name"; the restore request calls it "map", the salvage request "new_map".
+absl::Status RenameNameField(const absl::Status& status, absl::string_view field) {
   if (status.code() != absl::StatusCode::kInvalidArgument || !absl::StartsWith(status.message(), "name")) return status;
-  return absl::InvalidArgumentError(absl::StrCat("map", status.message().substr(4)));
+  return absl::InvalidArgumentError(absl::StrCat(field, status.message().substr(4)));
 }
 
 void ProblemToProto(const storage::VerifyProblem& p, v1::CheckProblem& problem) {
@@ -94,6 +95,28 @@ void VerifyReportToProto(const storage::VerifyReport& report, v1::CheckMapRespon
   log->set_first_lsn(report.log.first_lsn);
   log->set_last_lsn(report.log.last_lsn);
   log->set_torn_tail_bytes(report.log.torn_tail_bytes);
+}
+
+void SalvageReportToProto(const storage::SalvageReport& report, v1::SalvageMapResponse& response) {
+  MapInfoToProto(report.map, *response.mutable_map());
+  response.set_records_kept(report.records_kept());
+  response.set_records_lost(report.records_lost());
+  for (const storage::SalvageShard& s : report.shards) {
+    v1::ShardSalvage* shard = response.add_shards();
+    shard->set_shard(s.shard);
+    for (const storage::SalvageDatabase& d : s.databases) {
+      v1::DatabaseSalvage* db = shard->add_databases();
+      db->set_name(d.name);
+      db->set_kept(d.kept);
+      db->set_lost(d.lost);
+    }
+  }
+  response.set_log_records_kept(report.log.records_kept);
+  response.set_log_records_lost(report.log.records_lost);
+  response.set_log_bytes_lost(report.log.bytes_lost);
+  response.set_log_torn_tail_bytes(report.log.torn_tail_bytes);
+  for (const storage::VerifyProblem& p : report.lost) ProblemToProto(p, *response.add_lost());
+  response.set_losses(report.losses);
 }
 
 }  // namespace
@@ -263,7 +286,7 @@ absl::Status AdminServiceImpl::Restore(const v1::RestoreMapRequest& request, con
   if (!store.ok()) return store.status();
   auto info = (*store)->RestoreMap(*dir, *name);
   if (absl::IsDataLoss(info.status())) DaemonLog()->warn("restore refused: {}", std::string(info.status().message()));
-  if (!info.ok()) return RenameRestoreFields(info.status());
+  if (!info.ok()) return RenameNameField(info.status(), "map");
   MapInfoToProto(*info, *response.mutable_map());
   DaemonLog()->info("map {} restored from {}", info->name, *dir);
   return absl::OkStatus();
@@ -288,6 +311,32 @@ grpc::ServerUnaryReactor* AdminServiceImpl::CheckMap(grpc::CallbackServerContext
     } else {
       DaemonLog()->warn("check of map {}: {} problems, the first: {}", *name, report.problems.size(),
                   storage::FormatProblem(report.problems.front()));
+    }
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::SalvageMap(grpc::CallbackServerContext* context,
+                                                       const v1::SalvageMapRequest* request,
+                                                       v1::SalvageMapResponse* response) {
+  return ServeUnary(deps_, context, kSalvageMap, [this, context, request, response]() -> absl::Status {
+    auto name = ResolveMapName(*context, request->map(), "map");
+    if (!name.ok()) return name.status();
+    auto store = deps_.store->Get();
+    if (!store.ok()) return store.status();
+    const absl::Time start = admin_.clock->Now();
+    auto report = (*store)->SalvageMap(*name, request->new_map());
+    if (!report.ok()) {
+      DaemonLog()->warn("salvage of map {} failed: {}", *name, std::string(report.status().message()));
+      return RenameNameField(report.status(), "new_map");
+    }
+    SalvageReportToProto(*report, *response);
+    response->set_duration_seconds(absl::ToDoubleSeconds(admin_.clock->Now() - start));
+    DaemonLog()->warn("map {} salvaged as {}: {} records kept, {} lost; log: {} records kept, {} lost ({} bytes); {} losses",
+                *name, report->map.name, report->records_kept(), report->records_lost(), report->log.records_kept,
+                report->log.records_lost, report->log.bytes_lost, report->losses);
+    for (const storage::VerifyProblem& p : report->lost) {
+      DaemonLog()->warn("salvage of map {}: lost: {}", *name, storage::FormatProblem(p));
     }
     return absl::OkStatus();
   });

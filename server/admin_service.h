@@ -3,9 +3,10 @@
 //
 // RunUpdate, GetOperation, ListOperations and CancelOperation only touch the operation registry and
 // the catalog, and run inline; BackupMap and RestoreMap copy files, CheckMap reads a whole map
-// (storage/verify.h) and GetServerStatus reads every map's statistics, so they run on the blocking
-// pool. Write methods (RunUpdate, CancelOperation,
-// BackupMap, RestoreMap) need a write token when tokens are configured.
+// (storage/verify.h), SalvageMap reads a damaged one and writes a new one (storage/salvage.h) and
+// GetServerStatus reads every map's statistics, so they run on the blocking pool. Write methods
+// (RunUpdate, CancelOperation, BackupMap, RestoreMap, SalvageMap) need a write token when tokens
+// are configured.
 // Thread-safety: gRPC calls the handlers from any thread; the registry is thread-safe and the
 // service's one mutable member, the backups in progress, has its own mutex.
 #pragma once
@@ -59,6 +60,8 @@ class AdminServiceImpl final : public v1::AdminService::CallbackService {
                                             v1::GetServerStatusResponse* response) override;
   grpc::ServerUnaryReactor* CheckMap(grpc::CallbackServerContext* context, const v1::CheckMapRequest* request,
                                      v1::CheckMapResponse* response) override;
+  grpc::ServerUnaryReactor* SalvageMap(grpc::CallbackServerContext* context, const v1::SalvageMapRequest* request,
+                                       v1::SalvageMapResponse* response) override;
 
  private:
   // The operation `name` (field "name"), checked against the map the call names, if any.

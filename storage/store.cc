@@ -144,11 +144,17 @@ absl::StatusOr<std::shared_ptr<MapStore>> Store::Map(const std::string& name) co
   std::lock_guard lock(mutex_);
   if (auto it = maps_.find(name); it != maps_.end()) return it->second;
   if (auto it = failed_.find(name); it != failed_.end()) return it->second.status;
+  if (salvaging_.contains(name)) {
+    return absl::UnavailableError(absl::StrCat("map \"", name, "\" is being salvaged into"));
+  }
   return absl::NotFoundError(absl::StrCat("no map named \"", name, "\""));
 }
 
 absl::Status Store::DeleteMap(const std::string& name) {
   std::lock_guard lock(mutex_);
+  if (salvaging_.contains(name)) {
+    return absl::FailedPreconditionError(absl::StrCat("map ", name, " is being salvaged; delete it once that ends"));
+  }
   auto info = catalog_->Get(name);
   if (!info.ok()) return info.status();
   if (absl::Status s = catalog_->Delete(name); !s.ok()) return s;

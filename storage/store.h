@@ -12,7 +12,7 @@
 // - A directory under maps/ that no catalog record names (a catalog record lost to damage, or a crash between a
 //   delete's catalog commit and its file removal) is left where it is and listed in UnknownDirectories() for an
 //   operator; no new map is given its id. Only DeleteMap removes a map's files, and only those of the map the catalog
-//   names; CreateMap and RestoreMap, when they fail, remove only the directory they created.
+//   names; CreateMap, RestoreMap and SalvageMap, when they fail, remove only the directory they created.
 //
 // Thread-safety: every method may be called from any thread.
 #pragma once
@@ -23,9 +23,11 @@
 #include <vector>
 
 #include "absl/container/flat_hash_map.h"
+#include "absl/container/flat_hash_set.h"
 #include "absl/status/statusor.h"
 #include "storage/catalog.h"
 #include "storage/map_store.h"
+#include "storage/salvage.h"
 
 namespace fremen::storage {
 
@@ -59,6 +61,14 @@ class Store {
   // loaded (every record checked) before the map is listed.
   absl::StatusOr<MapInfo> RestoreMap(const std::string& dir, const std::string& name);
 
+  // A new map `new_name` (empty: name + "-salvaged") holding everything of the failed map `name` that verifies, served
+  // once it opens like any other (storage/salvage.h); the failed map and its files are left as they are. NotFound for
+  // an unknown map, FailedPrecondition for one that is not failed (it is copied with BackupMap/RestoreMap),
+  // AlreadyExists when new_name is taken. When the copy does not open, only the directory this call made is removed.
+  // The files are read and written without holding the store's lock (the other maps serve meanwhile); until the call
+  // returns, both maps refuse DeleteMap and Map(new_name) answers Unavailable.
+  absl::StatusOr<SalvageReport> SalvageMap(const std::string& name, const std::string& new_name);
+
   // Maps that did not open at Open, in name order.
   std::vector<FailedMap> FailedMaps() const;
   // Directories under <data dir>/maps that no catalog record names (full paths, sorted).
@@ -82,9 +92,11 @@ class Store {
   const std::string data_dir_;
   const StoreOptions options_;
   std::unique_ptr<Catalog> catalog_;
-  mutable std::mutex mutex_;  // guards maps_, failed_ and serialises create/delete/restore
+  mutable std::mutex mutex_;  // guards maps_, failed_, salvaging_ and serialises create/delete/restore
   absl::flat_hash_map<std::string, std::shared_ptr<MapStore>> maps_;
   absl::flat_hash_map<std::string, FailedMap> failed_;
+  // Maps a salvage reads or creates, without holding mutex_ (SalvageMap): not deleted meanwhile.
+  absl::flat_hash_set<std::string> salvaging_;
   std::vector<std::string> unknown_dirs_;  // found at Open; read-only after
 };
 

@@ -16,86 +16,21 @@
 #include "storage/model/record_codec.h"
 #include "storage/store.h"
 #include "storage/testing/file_damage.h"
+#include "storage/testing/labelled_states.h"
 #include "storage/testing/scans.h"
 #include "testing/temp_dir.h"
 
 namespace fremen::storage {
 namespace {
 
+using testing::Bytes;
+using testing::Fill;
+using testing::Fingerprints;
+using testing::Generic;
+using testing::kStates;
+using testing::Record;
+using testing::ShardRecords;
 using fremen::testing::TempDir;
-
-constexpr uint64_t kStates = 1024;
-
-MapInfo Generic(const std::string& name) {
-  MapInfo info;
-  info.name = name;
-  info.kind = MapKind::kGeneric;
-  info.shards = 1;
-  return info;
-}
-
-// 1024 labelled states: every fourth never changes (a static record), the others each follow their own rhythm, so that
-// no two records are alike.
-void Fill(MapStore& map) {
-  for (uint64_t i = 0; i < 24; ++i) {
-    ObservationBatch b;
-    b.writer_id = 1;
-    b.sequence = i + 1;
-    b.time = 1.7e9 + 3600.0 * i;
-    for (uint64_t k = 1; k <= kStates; ++k) {
-      b.keys.push_back(k);
-      b.values.push_back(k % 4 == 0 ? 0.0f : static_cast<float>(std::fmod(std::sqrt(2.0) * k + 0.1 * i, 1.0)));
-      if (i == 0) b.labels.push_back({k, "state" + std::to_string(k), k % 2 == 0 ? "even" : "odd"});
-    }
-    ASSERT_TRUE(map.Write(b).ok());
-  }
-}
-
-// Each state's whole model, as bytes: equal fingerprints are equal models.
-std::map<uint64_t, std::string> Fingerprints(const MapStore& map) {
-  std::map<uint64_t, std::string> out;
-  for (uint64_t k = 1; k <= kStates; ++k) {
-    const auto snapshot = map.Snapshot(k);
-    if (!snapshot) continue;
-    std::string& f = out[k];
-    f = snapshot->is_static ? "static:" + model::EncodeStaticState(snapshot->static_state)
-                            : "dynamic:" + model::EncodeStateModel(*snapshot->model);
-    f += "|" + snapshot->name + "|" + snapshot->group;
-  }
-  return out;
-}
-
-struct Record {
-  std::string db;
-  std::string key;
-  std::string value;  // without its checksum
-};
-
-// Every record of a shard's environment, read through LmdbEnv (so checked).
-std::vector<Record> ShardRecords(const std::string& shard_dir) {
-  LmdbOptions options;
-  options.databases = {"static", "dynamic", "lossless", "wide", "labels", "meta"};
-  auto env = LmdbEnv::Open(shard_dir, options);
-  EXPECT_TRUE(env.ok()) << env.status();
-  std::vector<Record> records;
-  if (!env.ok()) return records;
-  EXPECT_TRUE(
-      (*env)
-          ->Read([&](LmdbTxn& txn) -> absl::Status {
-            for (const std::string& db : options.databases) {
-              const absl::Status s = txn.Scan(*txn.Db(db), {}, {}, [&](auto key, auto value) {
-                records.push_back({db, std::string(key.begin(), key.end()), std::string(value.begin(), value.end())});
-                return true;
-              });
-              if (!s.ok()) return s;
-            }
-            return absl::OkStatus();
-          })
-          .ok());
-  return records;
-}
-
-std::span<const uint8_t> Bytes(const std::string& s) { return {reinterpret_cast<const uint8_t*>(s.data()), s.size()}; }
 
 std::string MapDir(const TempDir& dir, uint64_t id) { return dir.path() + "/maps/" + std::to_string(id); }
 

@@ -3,13 +3,11 @@
 #include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cinttypes>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <functional>
@@ -23,11 +21,13 @@
 #include "storage/catalog.h"
 #include "storage/cell_key.h"
 #include "storage/dedup_table.h"
+#include "storage/isolated_child.h"
 #include "storage/lmdb/lmdb_env.h"
 #include "storage/model/lossless_history.h"
 #include "storage/model/record_codec.h"
 #include "storage/model/varint.h"
 #include "storage/model/wide_bodies.h"
+#include "storage/shard_record_checks.h"
 #include "storage/shard_records.h"
 #include "storage/static_bricks.h"
 #include "storage/wal/wal.h"
@@ -63,7 +63,7 @@ struct ShardResult {
 class ShardChecker {
  public:
   ShardChecker(const MapInfo& info, const model::ModelSettings& settings, uint32_t shard, ShardResult& result)
-      : info_(info), settings_(settings), shard_(shard), keys_(info.grid.keys()), result_(result) {
+      : info_(info), shard_(shard), checks_(info, settings, shard), result_(result) {
     result_.report.shard = shard;
   }
 
@@ -123,45 +123,15 @@ class ShardChecker {
     }
   }
 
-  // The key's place: this shard, and a cell of the grid.
-  absl::Status CheckPlace(uint64_t key) const {
-    if (const uint32_t owner = ShardOf(key, info_.shards); owner != shard_) {
-      return absl::DataLossError(absl::StrCat("belongs to shard ", owner, ", not this one"));
-    }
-    if (info_.kind == MapKind::kGrid) {
-      if (!keys_.IsCellKey(key)) return absl::DataLossError("not the key of a grid cell");
-      const auto cell = keys_.Cell(key);
-      if (!info_.grid.Contains(cell[0], cell[1], cell[2])) {
-        return absl::DataLossError(absl::StrCat("cell (", cell[0], ", ", cell[1], ", ", cell[2], ") is outside the ",
-                                                info_.grid.size[0], "×", info_.grid.size[1], "×", info_.grid.size[2],
-                                                " grid"));
-      }
-    }
-    return absl::OkStatus();
-  }
-
   absl::Status CheckStatic(uint64_t brick, std::string_view value) {
-    if (brick > (UINT64_MAX >> kBrickBits)) return absl::DataLossError("not a brick key");
-    if (const uint32_t owner = ShardOf(brick << kBrickBits, info_.shards); owner != shard_) {
-      return absl::DataLossError(absl::StrCat("brick belongs to shard ", owner, ", not this one"));
-    }
-    auto decoded = StaticBrick::Decode(value);
-    if (!decoded.ok()) return decoded.status();
-    absl::Status first;
-    decoded->ForEach([&](uint32_t i, const model::StaticState&) {
-      const uint64_t key = brick << kBrickBits | i;
-      if (absl::Status s = CheckPlace(key); !s.ok() && first.ok()) {
-        first = absl::DataLossError(absl::StrCat("state ", key, ": ", s.message()));
-      }
-      static_keys_.insert(key);
-    });
-    return first;
+    StaticBrick decoded;
+    const absl::Status checked = checks_.Static(brick, value, &decoded);
+    decoded.ForEach([&](uint32_t i, const model::StaticState&) { static_keys_.insert(brick << kBrickBits | i); });
+    return checked;
   }
 
   absl::Status CheckDynamic(uint64_t key, std::string_view value) {
-    if (absl::Status s = CheckPlace(key); !s.ok()) return s;
-    auto decoded = model::DecodeStateModel<float>(value, settings_);
-    if (!decoded.ok()) return decoded.status();
+    if (absl::Status s = checks_.Dynamic(key, value); !s.ok()) return s;
     dynamic_keys_.insert(key);
     if (static_keys_.contains(key)) return absl::DataLossError("the state is also stored as never changed");
     return absl::OkStatus();
@@ -170,19 +140,15 @@ class ShardChecker {
   absl::Status CheckLossless(uint64_t key, std::string_view value) {
     if (info_.lossless_sampling_period <= 0) return absl::DataLossError("a lossless history in a map without them");
     if (!dynamic_keys_.contains(key)) return absl::DataLossError("a lossless history without its state");
-    return model::LosslessHistory::Decode(value).status();
+    return checks_.Lossless(value);
   }
 
   absl::Status CheckWide(uint64_t key, std::string_view value) {
     if (!dynamic_keys_.contains(key)) return absl::DataLossError("a wide body without its state");
-    model::WideBodies bodies(settings_.periods.size());
-    return bodies.Decode(0, value);
+    return checks_.Wide(value);
   }
 
-  absl::Status CheckLabel(uint64_t key, std::string_view value) {
-    if (absl::Status s = CheckPlace(key); !s.ok()) return s;
-    return sr::DecodeLabel(value).status();
-  }
+  absl::Status CheckLabel(uint64_t key, std::string_view value) { return checks_.Label(key, value); }
 
   // The meta records are named, not keyed by state. Read after the states (the touched list names
   // changed states).
@@ -237,9 +203,8 @@ class ShardChecker {
   }
 
   const MapInfo& info_;
-  const model::ModelSettings& settings_;
   const uint32_t shard_;
-  const GridKeys keys_;
+  const ShardRecordChecks checks_;
   ShardResult& result_;
   bool scan_failed_ = false;
   absl::flat_hash_set<uint64_t> static_keys_, dynamic_keys_;
@@ -323,62 +288,25 @@ absl::StatusOr<ShardResult> DecodeResult(std::string_view bytes, uint32_t shard)
   return result;
 }
 
-bool WriteAll(int fd, std::string_view bytes) {
-  while (!bytes.empty()) {
-    const ssize_t n = write(fd, bytes.data(), bytes.size());
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    bytes.remove_prefix(static_cast<size_t>(n));
-  }
-  return true;
-}
-
-// CheckShard in a forked child. The child only opens and reads files, decodes and writes to the
-// pipe (no logging, no locks the parent's other threads could hold), then _exits.
+// CheckShard in a forked child (storage/isolated_child.h), which sends its result over a pipe.
 ShardResult CheckShardIsolated(const std::string& dir, const MapInfo& info, const model::ModelSettings& settings,
                                uint32_t shard, bool live) {
   ShardResult failed;
   failed.report.shard = shard;
-  int fds[2];
-  if (pipe2(fds, O_CLOEXEC) != 0) {
-    failed.problems.push_back({ShardFile(shard), "", absl::StrCat("not verified: pipe: ", std::strerror(errno))});
-    return failed;
-  }
-  const pid_t pid = fork();
-  if (pid < 0) {
-    failed.problems.push_back({ShardFile(shard), "", absl::StrCat("not verified: fork: ", std::strerror(errno))});
-    close(fds[0]);
-    close(fds[1]);
-    return failed;
-  }
-  if (pid == 0) {
-    close(fds[0]);
-    signal(SIGPIPE, SIG_IGN);
-    const std::string bytes = EncodeResult(CheckShard(dir, info, settings, shard, live));
-    _exit(WriteAll(fds[1], bytes) ? 0 : 3);
-  }
-  close(fds[1]);
   std::string bytes;
-  char buffer[1 << 16];
-  for (;;) {
-    const ssize_t n = read(fds[0], buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    bytes.append(buffer, static_cast<size_t>(n));
-  }
-  close(fds[0]);
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (WIFSIGNALED(status)) {
-    failed.problems.push_back(
-        {ShardFile(shard), "", absl::StrCat("LMDB aborted reading it (signal ", WTERMSIG(status), ")")});
+  auto exit = RunIsolated(
+      [&](int fd) { return WriteAll(fd, EncodeResult(CheckShard(dir, info, settings, shard, live))); },
+      [&](std::string_view chunk) { bytes.append(chunk); });
+  if (!exit.ok()) {
+    failed.problems.push_back({ShardFile(shard), "", absl::StrCat("not verified: ", exit.status().message())});
     return failed;
   }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    failed.problems.push_back({ShardFile(shard), "",
-                               absl::StrCat("not verified: the verifying process exited with ",
-                                            WIFEXITED(status) ? WEXITSTATUS(status) : -1)});
+  if (exit->signal != 0) {
+    failed.problems.push_back({ShardFile(shard), "", DescribeChildExit(*exit)});
+    return failed;
+  }
+  if (!exit->ok()) {
+    failed.problems.push_back({ShardFile(shard), "", absl::StrCat("not verified: ", DescribeChildExit(*exit))});
     return failed;
   }
   auto result = DecodeResult(bytes, shard);

@@ -1,8 +1,8 @@
-// End-to-end tests of the operators' checks (storage/README.md, "Verification"): `fremenctl check
-// MAP` (AdminService.CheckMap) against a serving fremend, `fremend --verify` against a stopped data
-// directory, and the verification of a backup before `fremenctl restore` creates anything. Damage
-// is done to the files themselves, as a disk would: bytes flipped in a log segment, a page of a
-// shard zeroed.
+// End-to-end tests of the operators' checks (storage/README.md, "Verification"): `fremenctl check MAP` (AdminService.CheckMap)
+// against a serving fremend, `fremend --verify` against a stopped data directory, the
+// verification of a backup before `fremenctl restore` creates anything, and `fremenctl salvage`
+// (AdminService.SalvageMap) of a map that failed to open. Damage is done to the
+// files themselves, as a disk would: bytes flipped in a log segment, a page of a shard zeroed.
 #include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -28,6 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::fremen::client::Client;
 using ::fremen::client::ScanBuilder;
+using ::fremen::client::StateSet;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
@@ -174,6 +175,26 @@ TEST_F(CheckTest, AReadTokenIsEnoughToCheck) {
       grpc::StatusCode::NOT_FOUND);
 }
 
+TEST_F(CheckTest, SalvageNeedsAWriteToken) {
+  StopDaemon();
+  Start({"--tokens-file", dir_.Write("tokens", "read:reader-token\nwrite:writer-token\n")});
+  v1::SalvageMapRequest request;
+  request.set_map("nothing");
+  v1::SalvageMapResponse response;
+  const grpc::Status reader =
+      admin_->SalvageMap(CallContext({{"authorization", "Bearer reader-token"}}).get(), request, &response);
+  EXPECT_EQ(reader.error_code(), grpc::StatusCode::PERMISSION_DENIED) << reader.error_message();
+  // Past authorization with the write token: the map is looked up (and does not exist).
+  const grpc::Status status =
+      admin_->SalvageMap(CallContext({{"authorization", "Bearer writer-token"}}).get(), request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("nothing"));
+  request.clear_map();
+  const grpc::Status unnamed =
+      admin_->SalvageMap(CallContext({{"authorization", "Bearer writer-token"}}).get(), request, &response);
+  EXPECT_EQ(unnamed.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << unnamed.error_message();
+}
+
 TEST_F(CheckTest, FremendVerifyOfAStoppedDataDirectory) {
   MakeGrid("lab", 64, 32, 6);
   // Refused while the daemon holds the data directory.
@@ -234,6 +255,113 @@ TEST_F(CheckTest, ARestoreOfADamagedBackupIsDataLossAndCreatesNoMap) {
   EXPECT_EQ(std::distance(fs::directory_iterator(data_dir() + "/maps"), fs::directory_iterator()), 1);
   // The daemon still serves the map it has.
   EXPECT_EQ(Fremenctl("check lab").exit_code, 0);
+}
+
+// Every cell of an nx × ny grid, row by row.
+StateSet AllCells(uint32_t nx, uint32_t ny) {
+  std::vector<client::Cell> cells;
+  for (uint32_t y = 0; y < ny; ++y) {
+    for (uint32_t x = 0; x < nx; ++x) cells.push_back({x, y, 0});
+  }
+  return StateSet::Cells(cells);
+}
+
+TEST_F(CheckTest, FremenctlSalvageServesWhatSurvivedAndLeavesTheDamagedMap) {
+  constexpr uint32_t kX = 64, kY = 32;
+  MakeGrid("lab", kX, kY, 6);
+  {
+    // One more occupied scan, so that no cell predicts 0.5 (which a lost cell does).
+    auto session = client_->OpenIngest("lab");
+    ASSERT_TRUE(session.ok()) << session.status();
+    ScanBuilder scan(kStart + 6 * 3600.0);
+    scan.SetPatchBytes({0, 0, 0}, {kX, kY, 1}, std::string(uint64_t{kX} * kY, '\xff'));
+    ASSERT_TRUE((*session)->Send(*scan.Build()).ok());
+    ASSERT_TRUE((*session)->Close(absl::Seconds(60)).ok());
+  }
+  const double t = kStart + 7 * 3600.0;
+  auto before = client_->Predict("lab", AllCells(kX, kY), {t});
+  ASSERT_TRUE(before.ok()) << before.status();
+  ASSERT_TRUE(before->unobserved.empty());
+  const float p = before->probability(0, 0);
+  ASSERT_NE(p, 0.5f);  // a lost cell (0.5) must be told from a kept one
+  for (uint32_t i = 0; i < kX * kY; ++i) ASSERT_EQ(before->probability(0, i), p) << "cell " << i;
+  StopDaemon();
+  const std::string file = OnlyMapDir() + "/shard-0/data.mdb";
+  ZeroMiddlePage(file);
+  const std::string damaged = ReadAll(file);
+
+  Start();
+  ASSERT_FALSE(HasFatalFailure());
+  auto status = client_->GetServerStatus();
+  ASSERT_TRUE(status.ok()) << status.status();
+  ASSERT_EQ(status->failed_maps_size(), 1);
+  ASSERT_EQ(status->failed_maps(0).map(), "lab");
+
+  const Result r = Fremenctl("salvage lab");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_THAT(r.out, HasSubstr("map lab salvaged as lab-salvaged: "));
+  EXPECT_THAT(r.out, HasSubstr("map lab: lost: shard-0/data.mdb: "));
+  EXPECT_THAT(r.out, HasSubstr("map lab: shard-0: "));
+
+  // The report, through the RPC: a second salvage under the same name is refused, naming the field.
+  v1::SalvageMapRequest request;
+  request.set_map("lab");
+  request.set_new_map("lab-salvaged");
+  v1::SalvageMapResponse again;
+  grpc::Status refused = admin_->SalvageMap(CallContext().get(), request, &again);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::ALREADY_EXISTS) << refused.error_message();
+  EXPECT_THAT(refused.error_message(), HasSubstr("new_map"));
+  // A healthy map is not salvaged.
+  request.set_map("lab-salvaged");
+  request.set_new_map("");
+  refused = admin_->SalvageMap(CallContext().get(), request, &again);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << refused.error_message();
+  EXPECT_THAT(refused.error_message(), HasSubstr("map lab-salvaged is not damaged"));
+  // The JSON report of another salvage (to another name) counts what the first one kept.
+  const Result json = Fremenctl("salvage lab --to lab-2 --json");
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  EXPECT_THAT(json.out, HasSubstr("\"name\":\"lab-2\""));
+  auto second = client_->SalvageMap("lab", "lab-3");
+  ASSERT_TRUE(second.ok()) << second.status();
+  uint64_t kept = 0, lost = 0;
+  for (const v1::DatabaseSalvage& d : second->shards(0).databases()) {
+    if (d.name() == "dynamic") kept = d.kept(), lost = d.lost();
+  }
+  EXPECT_EQ(kept + lost, uint64_t{kX} * kY);
+  EXPECT_GT(lost, 0u);
+
+  // The salvaged map serves: every cell kept predicts as before, every lost one is unobserved.
+  for (const std::string map : {"lab-salvaged", "lab-3"}) {
+    auto after = client_->Predict(map, AllCells(kX, kY), {t});
+    ASSERT_TRUE(after.ok()) << map << ": " << after.status();
+    EXPECT_EQ(after->unobserved.size(), lost) << map;
+    uint32_t same = 0;
+    for (uint32_t i = 0; i < kX * kY; ++i) {
+      const float q = after->probability(0, i);
+      EXPECT_TRUE(q == p || q == 0.5f) << map << " cell " << i << ": " << q;
+      same += q == p;
+    }
+    EXPECT_EQ(same, kept) << map;
+  }
+  // It takes writes.
+  auto session = client_->OpenIngest("lab-salvaged");
+  ASSERT_TRUE(session.ok()) << session.status();
+  ASSERT_TRUE((*session)->Send(*ScanBuilder(t + 3600.0).AddCell({1, 1, 0}, 1.0f).Build()).ok());
+  ASSERT_TRUE((*session)->Close(absl::Seconds(30)).ok());
+  session->reset();
+
+  // The damaged map is left as it was: failed, its file unchanged.
+  EXPECT_EQ(ReadAll(file), damaged);
+  status = client_->GetServerStatus();
+  ASSERT_TRUE(status.ok());
+  ASSERT_EQ(status->failed_maps_size(), 1);
+  EXPECT_EQ(status->failed_maps(0).map(), "lab");
+
+  // And after a restart the salvaged map is an ordinary map.
+  StopDaemon();
+  Start();
+  ASSERT_FALSE(HasFatalFailure());
+  EXPECT_EQ(Fremenctl("check lab-salvaged").exit_code, 0);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "client/fremenctl/model_command.h"
 #include "client/fremenctl/query_commands.h"
 #include "client/fremenctl/region_command.h"
+#include "client/fremenctl/salvage_command.h"
 #include "client/fremenctl/update_command.h"
 
 int main(int argc, char** argv) {
@@ -33,6 +34,7 @@ int main(int argc, char** argv) {
   fremen::client::RegisterRestoreCommand(app);
   fremen::client::RegisterStatusCommand(app);
   fremen::client::RegisterCheckCommand(app);
+  fremen::client::RegisterSalvageCommand(app);
   fremen::client::RegisterIngestCommand(app);
   fremen::client::RegisterRegionCommand(app);
   fremen::client::RegisterModelCommand(app);

@@ -176,6 +176,11 @@ class Client {
   // Verifies the map's files while it serves (like fsck); problems are in the answer (clean is
   // false), not in the status. Reads every record: give it a deadline to match the map's size.
   absl::StatusOr<v1::CheckMapResponse> CheckMap(absl::string_view map, const CallOptions& call = {}) const;
+  // Salvages a damaged (failed) map into a new map `new_map` (empty: "<map>-salvaged"): everything that verifies is
+  // kept, what was lost is in the answer. Not retried (it creates a map). Reads the whole map: give it a deadline to
+  // match the map's size.
+  absl::StatusOr<v1::SalvageMapResponse> SalvageMap(absl::string_view map, absl::string_view new_map = "",
+                                                    const CallOptions& call = {}) const;
 
  private:
   std::shared_ptr<Connection> connection_;

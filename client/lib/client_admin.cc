@@ -126,4 +126,17 @@ absl::StatusOr<v1::CheckMapResponse> Client::CheckMap(absl::string_view map, con
   return response;
 }
 
+absl::StatusOr<v1::SalvageMapResponse> Client::SalvageMap(absl::string_view map, absl::string_view new_map,
+                                                          const CallOptions& call) const {
+  v1::SalvageMapRequest request;
+  request.set_map(std::string(map));
+  request.set_new_map(std::string(new_map));
+  v1::SalvageMapResponse response;
+  absl::Status status = connection_->CallOnce(call, map, [&](grpc::ClientContext& context) {
+    return connection_->admin().SalvageMap(&context, request, &response);
+  });
+  if (!status.ok()) return status;
+  return response;
+}
+
 }  // namespace fremen::client

@@ -114,13 +114,15 @@ struct SegmentScan {
 // after `after_lsn` to f (if any). Stops at the first record that is not intact and in sequence,
 // and tells a torn tail (nothing intact after it) from corruption.
 absl::StatusOr<SegmentScan> ScanSegment(const std::string& path, std::span<const uint8_t> data, uint64_t& expected_lsn,
-                                        uint64_t after_lsn, const RecordFn& f, uint64_t& delivered) {
+                                        uint64_t after_lsn, const RecordFn& f, uint64_t& delivered,
+                                        uint64_t& position) {
   SegmentScan scan;
   size_t pos = 0;
   while (pos < data.size()) {
     const auto record = IntactRecordAt(data, pos, [](uint64_t) { return true; });
     if (!record || record->lsn != expected_lsn) break;
     if (f && record->lsn > after_lsn) {
+      position = pos;  // where f refused, if it does
       if (absl::Status s = f(record->lsn, record->payload); !s.ok()) return s;
       ++delivered;
     }
@@ -128,6 +130,7 @@ absl::StatusOr<SegmentScan> ScanSegment(const std::string& path, std::span<const
     pos += kRecordHeader + record->payload.size();
   }
   scan.intact_bytes = pos;
+  position = pos;
   if (pos == data.size()) return scan;
   const std::string where =
       absl::StrCat("write-ahead log ", path, ": record at byte ", pos, " (LSN ", expected_lsn, ")");
@@ -148,7 +151,35 @@ std::span<const uint8_t> Bytes(const std::string& s) { return {reinterpret_cast<
 
 }  // namespace
 
-absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after_lsn, const RecordFn& f, Env* env) {
+namespace {
+
+// What lies from (segment `index`, byte `offset`) on: its bytes, and the highest LSN of an intact
+// record there (any record whose CRC holds and whose LSN is at least `lsn`).
+void MeasureRest(Env* env, const std::string& dir, const std::vector<uint64_t>& firsts, size_t index, uint64_t offset,
+                 uint64_t lsn, WalStop& stop) {
+  for (size_t i = index; i < firsts.size(); ++i) {
+    auto data = env->ReadFile(SegmentPath(dir, firsts[i]));
+    if (!data.ok()) continue;
+    const std::span<const uint8_t> bytes = Bytes(*data);
+    size_t pos = i == index ? std::min<uint64_t>(offset, bytes.size()) : 0;
+    stop.bytes_after += bytes.size() - pos;
+    if (i == index) ++pos;  // the record there is the damaged one
+    while (pos + kRecordHeader <= bytes.size()) {
+      const auto record = IntactRecordAt(bytes, pos, [&](uint64_t l) { return l >= lsn && l - lsn < (1ull << 40); });
+      if (!record) {
+        ++pos;
+        continue;
+      }
+      stop.highest_lsn_after = std::max(stop.highest_lsn_after, record->lsn);
+      pos += kRecordHeader + record->payload.size();
+    }
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after_lsn, const RecordFn& f, Env* env,
+                                          WalStop* stop) {
   WalReplayResult result;
   auto firsts = ListSegments(env, dir);
   if (!firsts.ok()) return firsts.status();
@@ -160,6 +191,10 @@ absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after
       // A recovery whose log ended below its checkpoints opens a new segment at its LSN floor: the
       // LSNs skipped are covered by the checkpoint. Any other gap, or an overlap, is damage.
       if (first < expected || first - 1 > after_lsn) {
+        if (stop != nullptr) {
+          *stop = WalStop{path, 0, expected, 0, 0};
+          MeasureRest(env, dir, *firsts, i, 0, expected, *stop);
+        }
         return absl::DataLossError(absl::StrCat("write-ahead log ", path, ": starts at LSN ", first,
                                                 " but the log before it ends at LSN ", expected - 1,
                                                 first < expected ? " (segments overlap)" : " (a segment is missing)"));
@@ -174,7 +209,14 @@ absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after
     }
     auto data = env->ReadFile(path);
     if (!data.ok()) return data.status();
-    auto scan = ScanSegment(path, Bytes(*data), expected, after_lsn, f, result.records);
+    uint64_t position = 0;
+    auto scan = ScanSegment(path, Bytes(*data), expected, after_lsn, f, result.records, position);
+    const bool stopped =
+        !scan.ok() || scan->end == SegmentScan::End::kCorrupt || (scan->end == SegmentScan::End::kTornTail && !last);
+    if (stopped && stop != nullptr) {
+      *stop = WalStop{path, position, expected, 0, 0};
+      MeasureRest(env, dir, *firsts, i, position, expected, *stop);
+    }
     if (!scan.ok()) return scan.status();
     if (scan->end == SegmentScan::End::kCorrupt) return absl::DataLossError(scan->damage);
     if (scan->end == SegmentScan::End::kTornTail) {
@@ -220,7 +262,8 @@ absl::StatusOr<std::unique_ptr<WalWriter>> WalWriter::Open(const std::string& di
   if (!data.ok()) return data.status();
   uint64_t expected = last_first;
   uint64_t ignored = 0;
-  auto scan = ScanSegment(last_path, Bytes(*data), expected, UINT64_MAX, nullptr, ignored);
+  uint64_t ignored_position = 0;
+  auto scan = ScanSegment(last_path, Bytes(*data), expected, UINT64_MAX, nullptr, ignored, ignored_position);
   if (!scan.ok()) return scan.status();
   if (scan->end == SegmentScan::End::kCorrupt) return absl::DataLossError(scan->damage);
   if (scan->end == SegmentScan::End::kTornTail) {

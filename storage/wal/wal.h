@@ -59,12 +59,23 @@ struct WalReplayResult {
   uint64_t torn_tail_bytes = 0;
 };
 
+// Where a replay that failed stopped: the first record it did not replay (damaged, out of sequence,
+// refused by the callback, or the start of a segment after a gap), for a salvage that keeps the log
+// before it (storage/salvage.h).
+struct WalStop {
+  std::string file;                // the segment's path
+  uint64_t offset = 0;             // the record's byte offset in it
+  uint64_t lsn = 0;                // the LSN expected there
+  uint64_t bytes_after = 0;        // from there to the end of the log, later segments included
+  uint64_t highest_lsn_after = 0;  // the highest LSN of an intact record found after it; 0: none
+};
+
 // Calls f(lsn, payload) for every intact record with LSN > after_lsn, in order. f's error stops the
 // replay and is returned. Corruption (see above) is DataLoss; a gap between segments is DataLoss
-// unless after_lsn covers it.
+// unless after_lsn covers it. When it fails, `stop` (if given) says where.
 absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after_lsn,
                                           const std::function<absl::Status(uint64_t, std::span<const uint8_t>)>& f,
-                                          Env* env = Env::Default());
+                                          Env* env = Env::Default(), WalStop* stop = nullptr);
 
 class WalWriter {
  public:
