@@ -205,7 +205,7 @@ absl::StatusOr<std::unique_ptr<LmdbEnv>> LmdbEnv::Open(const std::string& dir, c
   mdb_env_set_mapsize(env, options.initial_map_size);
   // NOTLS: read transactions are not tied to a thread (handlers may hop threads). NORDAHEAD: the
   // access pattern is random lookups or full scans into memory, where readahead only pollutes.
-  unsigned flags = MDB_NOTLS | MDB_NORDAHEAD;
+  unsigned flags = MDB_NOTLS | MDB_NORDAHEAD | (options.no_sync ? MDB_NOSYNC : 0);
   if (options.read_only) flags |= MDB_RDONLY | (options.no_lock ? MDB_NOLOCK : 0);
   rc = mdb_env_open(env, dir.c_str(), flags, 0640);
   if (rc != MDB_SUCCESS) {
@@ -283,6 +283,12 @@ absl::Status LmdbEnv::Read(const std::function<absl::Status(LmdbTxn&)>& f) const
   LmdbTxn wrapped(txn, &dbs_, &file_, &absent_);
   absl::Status status = f(wrapped);
   mdb_txn_abort(txn);
+  return status;
+}
+
+absl::Status LmdbEnv::Sync() {
+  absl::Status status = LmdbStatus(mdb_env_sync(env_, 1), "mdb_env_sync");
+  if (!status.ok()) Latch(status);
   return status;
 }
 

@@ -52,6 +52,9 @@ struct LmdbOptions {
   unsigned max_dbs = 16;
   // Reader slots (concurrent read transactions across processes). Default: 126 (LMDB's default).
   unsigned max_readers = 126;
+  // Skip fsync at commit: only for data whose durability comes from elsewhere (the write-ahead
+  // log) and that is synced explicitly with Sync() before the log is trimmed. Default: false.
+  bool no_sync = false;
   // The named databases used in this environment. They are created (when missing) and their
   // handles opened once, at Open: LMDB forbids opening handles in concurrent transactions.
   std::vector<std::string> databases;
@@ -136,6 +139,8 @@ class LmdbEnv {
   // Runs f in a read-only snapshot.
   absl::Status Read(const std::function<absl::Status(LmdbTxn&)>& f) const;
 
+  // Flushes to disk (for no_sync environments).
+  absl::Status Sync();
   // Clears reader slots left by dead processes; returns how many.
   absl::StatusOr<int> ClearStaleReaders();
   // A consistent copy (compacted) into an existing empty directory, while writers go on.
