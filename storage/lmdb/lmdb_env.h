@@ -52,8 +52,8 @@ struct LmdbOptions {
   unsigned max_dbs = 16;
   // Reader slots (concurrent read transactions across processes). Default: 126 (LMDB's default).
   unsigned max_readers = 126;
-  // Skip fsync at commit: only for data whose durability comes from elsewhere (the write-ahead
-  // log) and that is synced explicitly with Sync() before the log is trimmed. Default: false.
+  // Skip fsync at commit: for files written in many transactions and synced once with Sync() before
+  // anything depends on them (a salvage writes the new shards so, storage/salvage.h). Default: false.
   bool no_sync = false;
   // The named databases used in this environment. They are created (when missing) and their
   // handles opened once, at Open: LMDB forbids opening handles in concurrent transactions.
