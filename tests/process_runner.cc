@@ -103,6 +103,8 @@ RunResult RunProgram(const std::string& binary, const std::vector<std::string>& 
   // stdin, stdout and stderr served together, so that a program blocked writing one stream while
   // the test waits on another cannot deadlock.
   const auto deadline = Clock::now() + options.timeout;
+  const int err_copy =
+      options.stderr_copy_path.empty() ? -1 : open(options.stderr_copy_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   char buffer[65536];
   while (out_fd >= 0 || err_fd >= 0 || in_fd >= 0) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
@@ -119,6 +121,7 @@ RunResult RunProgram(const std::string& binary, const std::vector<std::string>& 
       const ssize_t n = read(fds[i].fd, buffer, sizeof buffer);
       if (n > 0) {
         (i == 0 ? result.out : result.err).append(buffer, n);
+        if (i == 1 && err_copy >= 0) (void)!write(err_copy, buffer, n);
       } else if (n == 0 || errno != EINTR) {
         CloseIfOpen(i == 0 ? out_fd : err_fd);
       }
@@ -130,6 +133,7 @@ RunResult RunProgram(const std::string& binary, const std::vector<std::string>& 
     }
   }
   if (result.timed_out) kill(-pid, SIGKILL);
+  if (err_copy >= 0) close(err_copy);
   CloseIfOpen(in_fd);
   CloseIfOpen(out_fd);
   CloseIfOpen(err_fd);

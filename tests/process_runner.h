@@ -18,6 +18,9 @@ struct RunOptions {
   std::vector<std::pair<std::string, std::string>> env;
   // After this the program (and the process group it leads) is killed with SIGKILL.
   std::chrono::milliseconds timeout = std::chrono::minutes(2);
+  // When set, stderr is also appended to this file as it arrives: for a test that watches what a
+  // program still running says (RunProgram on another thread).
+  std::string stderr_copy_path;
 };
 
 struct RunResult {
