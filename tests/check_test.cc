@@ -6,11 +6,9 @@
 #include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -34,30 +32,9 @@ using ::testing::Not;
 
 constexpr double kStart = 1699920000;
 
-struct Result {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
 std::string ReadAll(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-// Runs `binary args` to completion; stdout and stderr apart.
-Result RunBinary(const std::string& binary, const std::string& args, const std::string& err_path,
-                 const std::string& env = "") {
-  const std::string command = absl::StrCat(env, " '", binary, "' ", args, " 2>'", err_path, "'");
-  Result result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) result.out.append(buffer, n);
-  const int status = pclose(pipe);
-  if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-  result.err = ReadAll(err_path);
-  return result;
 }
 
 void WriteAt(const std::string& path, uint64_t offset, const std::string& bytes) {
@@ -89,13 +66,12 @@ class CheckTest : public DaemonTest {
     admin_ = v1::AdminService::NewStub(daemon_->NewChannel());
   }
 
-  Result Fremenctl(const std::string& args) {
-    return RunBinary(FREMENCTL_BINARY, args, dir_.Path("stderr"),
-                     absl::StrCat("FREMEN_ADDRESS='", daemon_->address(), "'"));
+  RunResult Fremenctl(const std::vector<std::string>& args) {
+    RunOptions options;
+    options.env = {{"FREMEN_ADDRESS", daemon_->address()}};
+    return RunProgram(FREMENCTL_BINARY, args, options);
   }
-  Result Verify() {
-    return RunBinary(FREMEND_BINARY, absl::StrCat("--data-dir '", data_dir(), "' --verify"), dir_.Path("stderr"));
-  }
+  RunResult Verify() { return RunFremend({"--data-dir", data_dir(), "--verify"}); }
 
   // A grid of nx × ny cells, every one changed (`scans` scans of alternating patches), so that its
   // shard holds many LMDB pages.
@@ -131,7 +107,7 @@ class CheckTest : public DaemonTest {
 
 TEST_F(CheckTest, FremenctlCheckOfAHealthyMapExitsZeroWithASummary) {
   MakeGrid("lab", 64, 32, 6);
-  const Result r = Fremenctl("check lab");
+  const RunResult r = Fremenctl({"check", "lab"});
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_THAT(r.out, HasSubstr("map lab: 1 shards, "));
   EXPECT_THAT(r.out, HasSubstr("log 1 segments, 6 records, LSN 1..6"));
@@ -141,7 +117,7 @@ TEST_F(CheckTest, FremenctlCheckOfAHealthyMapExitsZeroWithASummary) {
   ASSERT_TRUE(session.ok());
   ASSERT_TRUE((*session)->Send(*ScanBuilder(kStart + 7 * 3600.0).AddCell({1, 1, 0}, 1.0f).Build()).ok());
   ASSERT_TRUE((*session)->Close(absl::Seconds(30)).ok());
-  const Result json = Fremenctl("check --map lab --json");
+  const RunResult json = Fremenctl({"check", "--map", "lab", "--json"});
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_THAT(json.out, HasSubstr("\"clean\":true"));
   EXPECT_THAT(json.out, HasSubstr("\"last_lsn\":\"7\""));
@@ -157,7 +133,7 @@ TEST_F(CheckTest, CheckMapNamesTheFieldOfBadInput) {
   status = admin_->CheckMap(CallContext().get(), request, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
   EXPECT_THAT(status.error_message(), HasSubstr("no-such-map"));
-  const Result r = Fremenctl("check no-such-map");
+  const RunResult r = Fremenctl({"check", "no-such-map"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.err, HasSubstr("no-such-map"));
 }
@@ -198,12 +174,12 @@ TEST_F(CheckTest, SalvageNeedsAWriteToken) {
 TEST_F(CheckTest, FremendVerifyOfAStoppedDataDirectory) {
   MakeGrid("lab", 64, 32, 6);
   // Refused while the daemon holds the data directory.
-  const Result busy = Verify();
+  const RunResult busy = Verify();
   EXPECT_EQ(busy.exit_code, 1);
   EXPECT_THAT(busy.err, HasSubstr("in use by another fremend"));
   StopDaemon();
 
-  const Result clean = Verify();
+  const RunResult clean = Verify();
   ASSERT_EQ(clean.exit_code, 0) << clean.out << clean.err;
   EXPECT_THAT(clean.out, HasSubstr("map lab: clean"));
   EXPECT_THAT(clean.out, HasSubstr("summary: 1 maps verified, 0 with problems"));
@@ -217,14 +193,14 @@ TEST_F(CheckTest, FremendVerifyOfAStoppedDataDirectory) {
   std::string byte = ReadAll(segment).substr(size / 2, 1);
   byte[0] ^= 0x40;
   WriteAt(segment, size / 2, byte);
-  const Result damaged = Verify();
+  const RunResult damaged = Verify();
   EXPECT_EQ(damaged.exit_code, 1) << damaged.out << damaged.err;
   EXPECT_THAT(damaged.out, HasSubstr(absl::StrCat("map lab: wal/", segments.front().filename().string(), ": byte ")));
   EXPECT_THAT(damaged.out, HasSubstr("summary: 1 maps verified, 1 with problems"));
 
   // A zeroed page of the shard (LMDB aborts on it): named too, and the check goes on.
   ZeroMiddlePage(OnlyMapDir() + "/shard-0/data.mdb");
-  const Result zeroed = Verify();
+  const RunResult zeroed = Verify();
   EXPECT_EQ(zeroed.exit_code, 1);
   EXPECT_THAT(zeroed.out, HasSubstr("map lab: shard-0/data.mdb: "));
   EXPECT_THAT(zeroed.out, HasSubstr("summary: 1 maps verified"));
@@ -234,7 +210,7 @@ TEST_F(CheckTest, FremendVerifyOfAStoppedDataDirectory) {
 
 TEST_F(CheckTest, ARestoreOfADamagedBackupIsDataLossAndCreatesNoMap) {
   MakeGrid("lab", 128, 64, 4);
-  Result backup = Fremenctl("backup --map lab --to copy");
+  RunResult backup = Fremenctl({"backup", "--map", "lab", "--to", "copy"});
   ASSERT_EQ(backup.exit_code, 0) << backup.err;
   ZeroMiddlePage(dir_.Path("backups") + "/copy/shard-0/data.mdb");
 
@@ -245,16 +221,16 @@ TEST_F(CheckTest, ARestoreOfADamagedBackupIsDataLossAndCreatesNoMap) {
   const grpc::Status status = admin_->RestoreMap(CallContext().get(), request, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::DATA_LOSS) << status.error_message();
   EXPECT_THAT(status.error_message(), HasSubstr("shard-0/data.mdb"));
-  const Result restore = Fremenctl("restore --from copy --as restored2");
+  const RunResult restore = Fremenctl({"restore", "--from", "copy", "--as", "restored2"});
   EXPECT_EQ(restore.exit_code, 1);
   EXPECT_THAT(restore.err, HasSubstr("shard-0/data.mdb"));
-  const Result maps = Fremenctl("maps list");
+  const RunResult maps = Fremenctl({"maps", "list"});
   ASSERT_EQ(maps.exit_code, 0) << maps.err;
   EXPECT_THAT(maps.out, HasSubstr("lab"));
   EXPECT_THAT(maps.out, Not(HasSubstr("restored")));
   EXPECT_EQ(std::distance(fs::directory_iterator(data_dir() + "/maps"), fs::directory_iterator()), 1);
   // The daemon still serves the map it has.
-  EXPECT_EQ(Fremenctl("check lab").exit_code, 0);
+  EXPECT_EQ(Fremenctl({"check", "lab"}).exit_code, 0);
 }
 
 // Every cell of an nx × ny grid, row by row.

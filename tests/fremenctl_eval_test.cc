@@ -1,10 +1,8 @@
 // End-to-end tests of `fremenctl eval`: the real binary (FREMENCTL_BINARY, set by CMake) is run on
 // `time state` files generated in a temporary directory, and its output and exit code are checked.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -14,16 +12,15 @@
 #include <vector>
 
 #include "testing/temp_dir.h"
+#include "tests/process_runner.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int exit_code = -1;  // -1 when the process did not exit normally
-  std::string out;
-  std::string err;
-};
+using ::fremen::testing::RunProgram;
+using ::fremen::testing::RunResult;
+using Args = std::vector<std::string>;
 
 // Epoch times, so that the tests also cover phase precision at realistic timestamps.
 constexpr double kStart = 1.7e9;
@@ -50,27 +47,15 @@ class FremenctlEvalTest : public ::testing::Test {
     return Write(name, text.str());
   }
 
-  // Runs fremenctl with `args` (already quoted for the shell).
-  Result Run(const std::string& args) {
-    const std::string err_path = (dir_ / "stderr").string();
-    const std::string command = std::string("'") + FREMENCTL_BINARY + "' " + args + " 2>'" + err_path + "'";
-    Result result;
-    FILE* pipe = popen(command.c_str(), "r");
-    if (pipe == nullptr) return result;
-    char buffer[4096];
-    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) result.out.append(buffer, n);
-    const int status = pclose(pipe);
-    if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-    std::ifstream err(err_path);
-    result.err.assign(std::istreambuf_iterator<char>(err), std::istreambuf_iterator<char>());
-    return result;
-  }
+  RunResult Run(const Args& args) { return RunProgram(FREMENCTL_BINARY, args); }
 
   // `fremenctl eval` trained on three weeks of the daily square wave, tested on the week after.
-  Result EvalSquareWave(const std::string& extra_args = "") {
+  RunResult EvalSquareWave(const Args& extra_args = {}) {
     const std::string train = WriteDailySquareWave("train.txt", kStart, kStart + 3 * kWeek);
     const std::string test = WriteDailySquareWave("test.txt", kStart + 3 * kWeek, kStart + 4 * kWeek);
-    return Run("eval --train '" + train + "' --test '" + test + "' " + extra_args);
+    Args args = {"eval", "--train", train, "--test", test};
+    args.insert(args.end(), extra_args.begin(), extra_args.end());
+    return Run(args);
   }
 
   fremen::testing::TempDir temp_;
@@ -98,7 +83,7 @@ std::vector<Row> ParseTable(const std::string& out) {
 
 TEST_F(FremenctlEvalTest, PrintsOneLinePerOrderUpToMaxOrder) {
   for (int max_order : {0, 3, 5}) {
-    const Result result = EvalSquareWave("--max-order " + std::to_string(max_order));
+    const RunResult result = EvalSquareWave({"--max-order", std::to_string(max_order)});
     ASSERT_EQ(result.exit_code, 0) << result.err;
     const std::vector<Row> rows = ParseTable(result.out);
     ASSERT_EQ(rows.size(), static_cast<size_t>(max_order + 1)) << result.out;
@@ -113,23 +98,24 @@ TEST_F(FremenctlEvalTest, PrintsOneLinePerOrderUpToMaxOrder) {
 }
 
 TEST_F(FremenctlEvalTest, DefaultsToOrdersZeroToFive) {
-  const Result result = EvalSquareWave();
+  const RunResult result = EvalSquareWave();
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_EQ(ParseTable(result.out).size(), 6u);
 }
 
 TEST_F(FremenctlEvalTest, PeriodicModelBeatsTheMeanOnAPeriodicSignal) {
-  for (const char* args : {"", "--periods 100 --floor-periods", "--persistence"}) {
-    const Result result = EvalSquareWave(args);
-    ASSERT_EQ(result.exit_code, 0) << args << ": " << result.err;
+  for (const Args& args : {Args{}, Args{"--periods", "100", "--floor-periods"}, Args{"--persistence"}}) {
+    SCOPED_TRACE(::testing::PrintToString(args));
+    const RunResult result = EvalSquareWave(args);
+    ASSERT_EQ(result.exit_code, 0) << result.err;
     SCOPED_TRACE(result.out);
     const std::vector<Row> rows = ParseTable(result.out);
     ASSERT_EQ(rows.size(), 6u);
     // The mean (order 0) is wrong half of the time; the daily component gets almost all right.
-    EXPECT_GT(rows[0].err, 0.4) << args;
+    EXPECT_GT(rows[0].err, 0.4);
     for (size_t order = 1; order < rows.size(); ++order) {
-      EXPECT_LT(rows[order].err, rows[0].err / 5) << args << " order " << order;
-      EXPECT_LT(rows[order].mse, rows[0].mse) << args << " order " << order;
+      EXPECT_LT(rows[order].err, rows[0].err / 5) << "order " << order;
+      EXPECT_LT(rows[order].mse, rows[0].mse) << "order " << order;
     }
   }
 }
@@ -147,7 +133,7 @@ class FremenctlEvalBadInputTest : public FremenctlEvalTest, public ::testing::Wi
 TEST_P(FremenctlEvalBadInputTest, FailsNamingFileAndLine) {
   const std::string test = WriteDailySquareWave("test.txt", kStart, kStart + kDay);
   const std::string train = GetParam().text ? Write("train.txt", GetParam().text) : (dir_ / "missing.txt").string();
-  const Result result = Run("eval --train '" + train + "' --test '" + test + "'");
+  const RunResult result = Run({"eval", "--train", train, "--test", test});
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_EQ(result.out, "");
   const std::string place = GetParam().line > 0 ? train + ":" + std::to_string(GetParam().line) + ":" : train;
@@ -163,24 +149,30 @@ INSTANTIATE_TEST_SUITE_P(Cases, FremenctlEvalBadInputTest,
 
 TEST_F(FremenctlEvalTest, UsageErrorsExitWithTwo) {
   const std::string data = WriteDailySquareWave("data.txt", kStart, kStart + kDay);
-  const std::string files = "--train '" + data + "' --test '" + data + "'";
-  for (const std::string& args : {"eval " + files + " --no-such-option", std::string("eval --train '") + data + "'",
-                                  "eval " + files + " --max-order 65", "eval " + files + " --periods x",
-                                  std::string("no-such-command"), std::string("")}) {
-    const Result result = Run(args);
-    EXPECT_EQ(result.exit_code, 2) << "fremenctl " << args;
-    EXPECT_NE(result.err, "") << "fremenctl " << args;
+  const Args eval = {"eval", "--train", data, "--test", data};
+  auto with = [&](const Args& more) {
+    Args args = eval;
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+  };
+  for (const Args& args : {with({"--no-such-option"}), Args{"eval", "--train", data}, with({"--max-order", "65"}),
+                           with({"--periods", "x"}), Args{"no-such-command"}, Args{}}) {
+    const RunResult result = Run(args);
+    EXPECT_EQ(result.exit_code, 2) << "fremenctl " << ::testing::PrintToString(args);
+    EXPECT_NE(result.err, "") << "fremenctl " << ::testing::PrintToString(args);
+    // Usage errors say so on stderr only: stdout is for results.
+    EXPECT_EQ(result.out, "") << "fremenctl " << ::testing::PrintToString(args);
   }
 }
 
 TEST_F(FremenctlEvalTest, HelpDescribesEveryOption) {
-  const Result result = Run("eval --help");
+  const RunResult result = Run({"eval", "--help"});
   EXPECT_EQ(result.exit_code, 0);
   for (const char* option : {"--train", "--test", "--periods", "--longest", "--floor-periods", "--max-order",
                              "--persistence"}) {
     EXPECT_NE(result.out.find(option), std::string::npos) << option;
   }
-  EXPECT_EQ(Run("--help").exit_code, 0);
+  EXPECT_EQ(Run({"--help"}).exit_code, 0);
 }
 
 }  // namespace

@@ -2,11 +2,8 @@
 // map_server snapshot directories), region (map_server + PNG export), model (--plot) and demo —
 // running the real fremenctl binary (FREMENCTL_BINARY) against a real fremend (DaemonTest), and
 // checking the files it writes and, over gRPC, what the daemon then predicts.
-#include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -36,11 +33,7 @@ constexpr double kDay = 86400;
 // A Monday, 00:00 UTC.
 constexpr double kMonday = 1700438400;
 
-struct CommandResult {
-  int exit_code = -1;  // -1 when it did not exit normally
-  std::string out;
-  std::string err;
-};
+using ::fremen::testing::RunResult;
 
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -49,34 +42,17 @@ std::string ReadFile(const std::string& path) {
 
 class FremenctlFormatsTest : public testing::DaemonTest {
  protected:
-  // Runs fremenctl `args` --address <the daemon> to completion (fork + exec: no shell quoting).
-  CommandResult Run(std::vector<std::string> args) {
+  // Runs fremenctl `args` --address <the daemon> to completion.
+  RunResult Run(std::vector<std::string> args) {
     args.insert(args.end(), {"--address", daemon_->address()});
-    const std::string out_path = dir_.Path("stdout"), err_path = dir_.Path("stderr");
-    const pid_t pid = fork();
-    if (pid == 0) {
-      const int out = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      const int err = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(out, 1);
-      dup2(err, 2);
-      std::vector<char*> argv = {const_cast<char*>(FREMENCTL_BINARY)};
-      for (std::string& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(FREMENCTL_BINARY, argv.data());
-      _exit(127);
-    }
-    CommandResult result;
-    int status = 0;
-    if (pid > 0 && waitpid(pid, &status, 0) == pid && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-    result.out = ReadFile(out_path);
-    result.err = ReadFile(err_path);
-    return result;
+    return testing::RunProgram(FREMENCTL_BINARY, args);
   }
 
   // Runs and expects success, showing the output otherwise.
-  CommandResult RunOk(const std::vector<std::string>& args) {
-    CommandResult r = Run(args);
-    EXPECT_EQ(r.exit_code, 0) << "fremenctl " << ::testing::PrintToString(args) << "\nstdout: " << r.out
+  RunResult RunOk(const std::vector<std::string>& args) {
+    RunResult r = Run(args);
+    EXPECT_EQ(r.exit_code, 0) << "fremenctl " << ::testing::PrintToString(args) << ": " << testing::Describe(r)
+                              << "\nstdout: " << r.out
                               << "\nstderr: " << r.err;
     return r;
   }
@@ -139,16 +115,16 @@ class FremenctlFormatsTest : public testing::DaemonTest {
 TEST_F(FremenctlFormatsTest, IngestStatesFileThenModelPrintsIt) {
   // A week, the update (it publishes P), then a week scored at every order and the update that
   // selects one.
-  const CommandResult ingest = RunOk(
+  const RunResult ingest = RunOk(
       {"ingest", "--map", "lab", "--states", WriteDoorFile("week1.txt", 7), "--name", "door", "--create", "--update"});
   EXPECT_THAT(ingest.out, HasSubstr("created generic map lab"));
   EXPECT_THAT(ingest.out, HasSubstr("1008 batches, 1008 observations accepted, 0 rejected"));
   EXPECT_THAT(ingest.out, HasSubstr("update of lab: 1 states published"));
-  const CommandResult second =
+  const RunResult second =
       RunOk({"ingest", "--map", "lab", "--states", WriteDoorFile("week2.txt", 7, 7), "--name", "door", "--update"});
   EXPECT_THAT(second.out, Not(HasSubstr("created")));
 
-  const CommandResult model = RunOk({"model", "--map", "lab", "--name", "door"});
+  const RunResult model = RunOk({"model", "--map", "lab", "--name", "door"});
   EXPECT_THAT(model.out, HasSubstr("name: door"));
   EXPECT_THAT(model.out, HasSubstr("observations: 2016 from t = 1700438400.000"));
   // The daily period (24 h) is the strongest component of P.
@@ -170,7 +146,7 @@ TEST_F(FremenctlFormatsTest, IngestGridCsvCreatesAGridLargeEnough) {
                                      "100,0,0,0\n100,4,2,1\n"
                                      "# second scan\n"
                                      "200,0,0,0\n200,4,2,1\n200,1,1,0.5\n");
-  const CommandResult ingest = RunOk({"ingest", "--map", "grid", "--csv", csv, "--create", "--resolution", "0.5"});
+  const RunResult ingest = RunOk({"ingest", "--map", "grid", "--csv", csv, "--create", "--resolution", "0.5"});
   EXPECT_THAT(ingest.out, HasSubstr("2 batches, 5 observations accepted, 0 rejected"));
   const v1::Map map = GetMap("grid");
   EXPECT_EQ(map.kind(), v1::MAP_KIND_GRID);
@@ -193,7 +169,7 @@ TEST_F(FremenctlFormatsTest, MapServerImportThenRegionExportGivesTheSameCells) {
   std::filesystem::create_directory(snapshots);
   const formats::Image office = StaticOffice();
   for (int i = 0; i < 3; ++i) WriteSnapshot(snapshots, "office_" + std::to_string(1700000000 + i * 3600), office);
-  const CommandResult ingest = RunOk({"ingest", "--map", "office", "--map-server", snapshots, "--create"});
+  const RunResult ingest = RunOk({"ingest", "--map", "office", "--map-server", snapshots, "--create"});
   // 96 pixels, 6 unknown: 90 observations per snapshot.
   EXPECT_THAT(ingest.out, HasSubstr("ingested 3 map_server snapshots"));
   EXPECT_THAT(ingest.out, HasSubstr("270 observations accepted, 0 rejected"));
@@ -202,7 +178,7 @@ TEST_F(FremenctlFormatsTest, MapServerImportThenRegionExportGivesTheSameCells) {
   EXPECT_DOUBLE_EQ(map.grid().origin().x(), -1.0);
 
   const std::string prefix = dir_.Path("exported");
-  const CommandResult region = RunOk({"region", "--map", "office", "--time", "1700086400", "--out", prefix});
+  const RunResult region = RunOk({"region", "--map", "office", "--time", "1700086400", "--out", prefix});
   EXPECT_THAT(region.out, HasSubstr("12 x 8 cells"));
   EXPECT_THAT(region.out, HasSubstr("(36 occupied, 54 free, 6 unknown)"));
   absl::StatusOr<formats::MapMetadata> yaml = formats::ReadMapYaml(prefix + ".yaml");
@@ -256,7 +232,7 @@ TEST_F(FremenctlFormatsTest, MapServerTimesFileIntoAnExistingMap) {
   refs.mutable_cells()->add_y(2);
   EXPECT_NEAR(Predict("office", refs, 1700050000)[0], 0.5f, 1e-6);
   // Without --times the names carry no time: the error says how to fix it.
-  const CommandResult untimed = Run({"ingest", "--map", "office", "--map-server", snapshots});
+  const RunResult untimed = Run({"ingest", "--map", "office", "--map-server", snapshots});
   EXPECT_EQ(untimed.exit_code, 1);
   EXPECT_THAT(untimed.err, HasSubstr("morning.yaml: the file name does not end with its time"));
   EXPECT_THAT(untimed.err, HasSubstr("--times"));
@@ -266,7 +242,7 @@ TEST_F(FremenctlFormatsTest, ModelPlotWritesSvgAndPng) {
   const std::string door = WriteDoorFile("door.txt", 7);
   RunOk({"ingest", "--map", "lab", "--states", door, "--name", "door", "--create", "--update"});
   const std::string svg_path = dir_.Path("door.svg");
-  const CommandResult svg_run =
+  const RunResult svg_run =
       RunOk({"model", "--map", "lab", "--name", "door", "--plot", svg_path, "--observations", door});
   EXPECT_THAT(svg_run.out, HasSubstr("plot: " + svg_path));
   const std::string svg = ReadFile(svg_path);
@@ -296,7 +272,7 @@ TEST_F(FremenctlFormatsTest, ModelPlotWritesSvgAndPng) {
 }
 
 TEST_F(FremenctlFormatsTest, DemoPopulatesMapsThatPredict) {
-  const CommandResult demo = RunOk({"demo"});
+  const RunResult demo = RunOk({"demo"});
   EXPECT_THAT(demo.out, HasSubstr("demo-office (grid 40 x 20 cells of 0.25 m): 1008 batches, 806400 observations"));
   EXPECT_THAT(demo.out, HasSubstr("demo-states (door, meeting-room, kitchen-light): 1008 batches, 3024 observations"));
   EXPECT_THAT(demo.out, HasSubstr("7 updates of both maps"));
@@ -318,7 +294,7 @@ TEST_F(FremenctlFormatsTest, DemoPopulatesMapsThatPredict) {
   EXPECT_GT(Predict("demo-office", doorway, monday + 3 * 3600)[0], 0.6f);
 
   // The suggested predict command works (it is the other commands' syntax).
-  const CommandResult predict = RunOk({"predict", "--map", "demo-states", "--name", "door", "--name", "meeting-room",
+  const RunResult predict = RunOk({"predict", "--map", "demo-states", "--name", "door", "--name", "meeting-room",
                                        "--time", "2023-11-27T09:00:00Z", "--time", "2023-11-27T14:00:00Z"});
   EXPECT_THAT(predict.out, HasSubstr("door"));
   EXPECT_THAT(demo.out, HasSubstr("fremenctl predict --map demo-states --name door --name meeting-room --time "
@@ -339,7 +315,7 @@ TEST_F(FremenctlFormatsTest, DemoPopulatesMapsThatPredict) {
   EXPECT_EQ(night->at(20, 10), formats::kPixelOccupied);
 
   // Running it again does not overwrite the maps unless asked.
-  const CommandResult again = Run({"demo", "--days", "1"});
+  const RunResult again = Run({"demo", "--days", "1"});
   EXPECT_EQ(again.exit_code, 1);
   EXPECT_THAT(again.err, HasSubstr("map demo-office already exists; pass --replace"));
   RunOk({"demo", "--days", "1", "--replace"});
@@ -348,7 +324,7 @@ TEST_F(FremenctlFormatsTest, DemoPopulatesMapsThatPredict) {
 TEST_F(FremenctlFormatsTest, BadInputsSayWhatToFix) {
   // ingest: a bad CSV line names file:line and field; no input at all is a usage error.
   const std::string bad_csv = dir_.Write("bad.csv", "time,x,y,state\n1,2,3,1\n2,-2,3,1\n");
-  CommandResult r = Run({"ingest", "--map", "grid", "--csv", bad_csv, "--create"});
+  RunResult r = Run({"ingest", "--map", "grid", "--csv", bad_csv, "--create"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.err, HasSubstr("bad.csv:3: field x: expected a cell index"));
   r = Run({"ingest", "--map", "grid"});

@@ -4,10 +4,8 @@
 // with the message that says what to fix. Data is put in through the C++ client library.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <future>
 #include <iterator>
@@ -30,12 +28,6 @@ using ::testing::Not;
 constexpr double kDay = 86400;
 constexpr double kStart = 1699920000;  // midnight UTC
 
-struct Result {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
 std::string ReadAll(const std::string& path) {
   std::ifstream in(path);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -57,25 +49,21 @@ class FremenctlTest : public DaemonTest {
     client_.emplace(*Client::Connect(options));
   }
 
-  // Runs fremenctl with `args` (quoted for the shell) against the test's daemon (FREMEN_ADDRESS);
-  // stderr goes to `err_path` (default: a file of the test's directory).
-  Result Run(const std::string& args, const std::string& env = "", std::string err_path = "") {
-    if (err_path.empty()) err_path = dir_.Path("stderr");
-    const std::string command = absl::StrCat("FREMEN_ADDRESS='", daemon_->address(), "' ", env, " '", FREMENCTL_BINARY,
-                                             "' ", args, " 2>'", err_path, "'");
-    Result result;
-    FILE* pipe = popen(command.c_str(), "r");
-    if (pipe == nullptr) return result;
-    char buffer[4096];
-    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) result.out.append(buffer, n);
-    const int status = pclose(pipe);
-    if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-    result.err = ReadAll(err_path);
-    return result;
+  // Runs fremenctl with `args` against the test's daemon (FREMEN_ADDRESS, before the variables
+  // of `options.env`).
+  RunResult Run(const std::vector<std::string>& args, RunOptions options = {}) {
+    options.env.insert(options.env.begin(), {"FREMEN_ADDRESS", daemon_->address()});
+    return RunProgram(FREMENCTL_BINARY, args, options);
+  }
+  // With FREMEN_TOKEN=`token`.
+  RunResult RunWithToken(const std::vector<std::string>& args, const std::string& token) {
+    RunOptions options;
+    options.env = {{"FREMEN_TOKEN", token}};
+    return Run(args, options);
   }
 
   void CreateGrid(const std::string& name, uint32_t nx = 20, uint32_t ny = 10) {
-    Result r = Run(absl::StrCat("maps create ", name, " --resolution 0.5 --size ", nx, " ", ny));
+    RunResult r = Run({"maps", "create", name, "--resolution", "0.5", "--size", absl::StrCat(nx), absl::StrCat(ny)});
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
 
@@ -90,7 +78,7 @@ class FremenctlTest : public DaemonTest {
         ASSERT_TRUE((*session)->Send(*ScanBuilder(t).AddCell({2, 3, 0}, DayPattern(t)).Build()).ok());
       }
       ASSERT_TRUE((*session)->Close(absl::Seconds(60)).ok());
-      Result r = Run(absl::StrCat("update --map ", map, " --wait"));
+      RunResult r = Run({"update", "--map", map, "--wait"});
       ASSERT_EQ(r.exit_code, 0) << r.err;
     }
   }
@@ -115,49 +103,49 @@ class FremenctlTest : public DaemonTest {
 
 TEST_F(FremenctlTest, MapsCreateListGetDelete) {
   CreateGrid("lab");
-  Result generic = Run("maps create doors --generic --max-order 3 --criterion squared");
+  RunResult generic = Run({"maps", "create", "doors", "--generic", "--max-order", "3", "--criterion", "squared"});
   ASSERT_EQ(generic.exit_code, 0) << generic.err;
   EXPECT_THAT(generic.out, HasSubstr("created map doors: generic"));
 
-  Result list = Run("maps list");
+  RunResult list = Run({"maps", "list"});
   ASSERT_EQ(list.exit_code, 0) << list.err;
   EXPECT_THAT(list.out, HasSubstr("doors"));
   EXPECT_THAT(list.out, HasSubstr("grid 20x10x1 cells of 0.5 m"));
   EXPECT_LT(list.out.find("doors"), list.out.find("lab"));  // name order
 
-  Result get = Run("maps get doors");
+  RunResult get = Run({"maps", "get", "doors"});
   ASSERT_EQ(get.exit_code, 0) << get.err;
   EXPECT_THAT(get.out, HasSubstr("max_order: 3"));
   EXPECT_THAT(get.out, HasSubstr("criterion: squared"));
-  Result json = Run("maps get lab --json");
+  RunResult json = Run({"maps", "get", "lab", "--json"});
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_THAT(json.out, HasSubstr("\"resolution\":0.5"));
 
-  Result del = Run("maps delete doors --yes");
+  RunResult del = Run({"maps", "delete", "doors", "--yes"});
   ASSERT_EQ(del.exit_code, 0) << del.err;
-  EXPECT_THAT(Run("maps list").out, Not(HasSubstr("doors")));
+  EXPECT_THAT(Run({"maps", "list"}).out, Not(HasSubstr("doors")));
 }
 
 TEST_F(FremenctlTest, MapsBadInputSaysWhatToFix) {
-  Result no_size = Run("maps create lab --resolution 0.5");
+  RunResult no_size = Run({"maps", "create", "lab", "--resolution", "0.5"});
   EXPECT_EQ(no_size.exit_code, 2);
   EXPECT_THAT(no_size.err, HasSubstr("needs --resolution METRES and --size X Y"));
-  Result bad_name = Run("maps create 'bad name!' --generic");
+  RunResult bad_name = Run({"maps", "create", "bad name!", "--generic"});
   EXPECT_EQ(bad_name.exit_code, 1);
   EXPECT_THAT(bad_name.err, HasSubstr("name"));
   CreateGrid("lab");
-  Result taken = Run("maps create lab --generic");
+  RunResult taken = Run({"maps", "create", "lab", "--generic"});
   EXPECT_EQ(taken.exit_code, 1);
   EXPECT_THAT(taken.err, HasSubstr("pick another name"));
-  Result missing = Run("maps get nope");
+  RunResult missing = Run({"maps", "get", "nope"});
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_THAT(missing.err, HasSubstr("map \"nope\" does not exist"));
   EXPECT_THAT(missing.err, HasSubstr("fremenctl maps list"));
-  Result unconfirmed = Run("maps delete lab");
+  RunResult unconfirmed = Run({"maps", "delete", "lab"});
   EXPECT_EQ(unconfirmed.exit_code, 2);
   EXPECT_THAT(unconfirmed.err, HasSubstr("add --yes"));
-  EXPECT_THAT(Run("maps list").out, HasSubstr("lab"));  // still there
-  EXPECT_EQ(Run("maps").exit_code, 2);                  // a subcommand is required
+  EXPECT_THAT(Run({"maps", "list"}).out, HasSubstr("lab"));  // still there
+  EXPECT_EQ(Run({"maps"}).exit_code, 2);                  // a subcommand is required
 }
 
 // --- queries ---
@@ -165,8 +153,8 @@ TEST_F(FremenctlTest, MapsBadInputSaysWhatToFix) {
 TEST_F(FremenctlTest, PredictFollowsThePattern) {
   CreateGrid("lab");
   IngestTwoWeeks("lab");
-  Result r = Run("predict --map lab --cell 2,3 --cell 9,9 --time 2023-11-28T12:00:00Z --time " +
-                 absl::StrCat(kStart + 14 * kDay) + " --confidence 0.5");
+  RunResult r = Run({"predict", "--map", "lab", "--cell", "2,3", "--cell", "9,9", "--time", "2023-11-28T12:00:00Z", "--time",
+                     absl::StrCat(kStart + 14 * kDay), "--confidence", "0.5"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::istringstream lines(r.out);
   std::string header, noon, unobserved, midnight;
@@ -184,25 +172,25 @@ TEST_F(FremenctlTest, PredictFollowsThePattern) {
 
 TEST_F(FremenctlTest, PredictBadInputSaysWhatToFix) {
   CreateGrid("lab");
-  Result cell = Run("predict --map lab --cell 2 --time now");
+  RunResult cell = Run({"predict", "--map", "lab", "--cell", "2", "--time", "now"});
   EXPECT_EQ(cell.exit_code, 2);
   EXPECT_THAT(cell.err, HasSubstr("cell \"2\" is not X,Y or X,Y,Z"));
-  Result time = Run("predict --map lab --cell 2,3 --time tomorrow");
+  RunResult time = Run({"predict", "--map", "lab", "--cell", "2,3", "--time", "tomorrow"});
   EXPECT_EQ(time.exit_code, 2);
   EXPECT_THAT(time.err, HasSubstr("RFC 3339"));
-  Result none = Run("predict --map lab --time now");
+  RunResult none = Run({"predict", "--map", "lab", "--time", "now"});
   EXPECT_EQ(none.exit_code, 2);
   EXPECT_THAT(none.err, HasSubstr("name the states with one of --cell"));
-  Result outside = Run("predict --map lab --id 3 --time now");
+  RunResult outside = Run({"predict", "--map", "lab", "--id", "3", "--time", "now"});
   EXPECT_EQ(outside.exit_code, 1);  // ids are for generic maps: the daemon says so
   EXPECT_FALSE(outside.err.empty());
-  Result unknown = Run("predict --map nope --cell 1,1 --time now");
+  RunResult unknown = Run({"predict", "--map", "nope", "--cell", "1,1", "--time", "now"});
   EXPECT_EQ(unknown.exit_code, 1);
   EXPECT_THAT(unknown.err, HasSubstr("fremenctl maps list"));
 }
 
 TEST_F(FremenctlTest, TopRanksTheGroup) {
-  ASSERT_EQ(Run("maps create doors --generic").exit_code, 0);
+  ASSERT_EQ(Run({"maps", "create", "doors", "--generic"}).exit_code, 0);
   auto session = client_->OpenIngest("doors");
   ASSERT_TRUE(session.ok());
   for (int i = 0; i < 24; ++i) {
@@ -213,15 +201,15 @@ TEST_F(FremenctlTest, TopRanksTheGroup) {
     ASSERT_TRUE((*session)->Send(*scan.Build()).ok());
   }
   ASSERT_TRUE((*session)->Close(absl::Seconds(30)).ok());
-  Result r = Run(absl::StrCat("top --map doors --group entrances -n 2 --time ", kStart + kDay));
+  RunResult r = Run({"top", "--map", "doors", "--group", "entrances", "-n", "2", "--time", absl::StrCat(kStart + kDay)});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("1     1                     front"));
   EXPECT_THAT(r.out, Not(HasSubstr("back")));  // only the top 2
 
-  Result zero = Run("top --map doors --group entrances -n 0");
+  RunResult zero = Run({"top", "--map", "doors", "--group", "entrances", "-n", "0"});
   EXPECT_EQ(zero.exit_code, 2);
   EXPECT_THAT(zero.err, HasSubstr("-n"));
-  Result group = Run("top --map doors --group windows");
+  RunResult group = Run({"top", "--map", "doors", "--group", "windows"});
   EXPECT_EQ(group.exit_code, 1);
   EXPECT_THAT(group.err, HasSubstr("no group \"windows\""));
 }
@@ -229,17 +217,17 @@ TEST_F(FremenctlTest, TopRanksTheGroup) {
 TEST_F(FremenctlTest, AnomaliesFlagsWhatContradictsThePattern) {
   CreateGrid("lab");
   IngestTwoWeeks("lab");
-  Result r =
-      Run("anomalies --map lab --cell 2,3 --cell 2,3 --value 0 --value 1 --time 2023-11-28T12:00:00Z "
-          "--confidence 0.7");
+  RunResult r =
+      Run({"anomalies", "--map", "lab", "--cell", "2,3", "--cell", "2,3", "--value", "0", "--value", "1", "--time",
+           "2023-11-28T12:00:00Z", "--confidence", "0.7"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("yes"));
   EXPECT_THAT(r.out, HasSubstr("1 of 2 observations anomalous at confidence 0.7"));
 
-  Result mismatch = Run("anomalies --map lab --cell 2,3 --cell 2,4 --value 0 --time now");
+  RunResult mismatch = Run({"anomalies", "--map", "lab", "--cell", "2,3", "--cell", "2,4", "--value", "0", "--time", "now"});
   EXPECT_EQ(mismatch.exit_code, 2);
   EXPECT_THAT(mismatch.err, HasSubstr("give one --value per state: 2 states but 1 values"));
-  Result confidence = Run("anomalies --map lab --cell 2,3 --value 0 --time now --confidence 0.2");
+  RunResult confidence = Run({"anomalies", "--map", "lab", "--cell", "2,3", "--value", "0", "--time", "now", "--confidence", "0.2"});
   EXPECT_EQ(confidence.exit_code, 2);
   EXPECT_THAT(confidence.err, HasSubstr("--confidence"));
 }
@@ -247,30 +235,30 @@ TEST_F(FremenctlTest, AnomaliesFlagsWhatContradictsThePattern) {
 TEST_F(FremenctlTest, StatsCountTheObservations) {
   CreateGrid("lab");
   IngestTwoWeeks("lab");
-  Result r = Run("stats --map lab");
+  RunResult r = Run({"stats", "--map", "lab"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("states: 1 (1 dynamic)"));
   EXPECT_THAT(r.out, HasSubstr("observations: 336"));
-  Result json = Run("stats --map lab --json");
+  RunResult json = Run({"stats", "--map", "lab", "--json"});
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_THAT(json.out, HasSubstr("\"observations\":\"336\""));
-  Result missing = Run("stats --map nope");
+  RunResult missing = Run({"stats", "--map", "nope"});
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_THAT(missing.err, HasSubstr("map \"nope\" does not exist"));
-  EXPECT_EQ(Run("stats").exit_code, 2);  // --map is required
+  EXPECT_EQ(Run({"stats"}).exit_code, 2);  // --map is required
 }
 
 // --- update ---
 
 TEST_F(FremenctlTest, UpdateStartsOrWaitsWithProgressAndSummary) {
   CreateGrid("lab");
-  Result started = Run("update --map lab");
+  RunResult started = Run({"update", "--map", "lab"});
   ASSERT_EQ(started.exit_code, 0) << started.err;
   EXPECT_THAT(started.out, HasSubstr("started operations/"));
   EXPECT_THAT(started.out, HasSubstr("fremenctl update --map lab --wait"));
 
   MakeDynamicGrid("big", 512, 256);
-  Result waited = Run("update --map big --wait --poll-interval 0.05 --line-interval 0");
+  RunResult waited = Run({"update", "--map", "big", "--wait", "--poll-interval", "0.05", "--line-interval", "0"});
   ASSERT_EQ(waited.exit_code, 0) << waited.err;
   EXPECT_THAT(waited.out, HasSubstr("done: 131072 states published"));
   EXPECT_THAT(waited.out, HasSubstr("orders: "));
@@ -278,10 +266,10 @@ TEST_F(FremenctlTest, UpdateStartsOrWaitsWithProgressAndSummary) {
   EXPECT_THAT(waited.err, HasSubstr("update of big: done, 131072/131072 states (100%)"));
   EXPECT_THAT(waited.err, Not(HasSubstr("\r")));
 
-  Result unknown = Run("update --map nope --wait");
+  RunResult unknown = Run({"update", "--map", "nope", "--wait"});
   EXPECT_EQ(unknown.exit_code, 1);
   EXPECT_THAT(unknown.err, HasSubstr("fremenctl maps list"));
-  EXPECT_EQ(Run("update --map lab --poll-interval 0").exit_code, 2);
+  EXPECT_EQ(Run({"update", "--map", "lab", "--poll-interval", "0"}).exit_code, 2);
 }
 
 TEST_F(FremenctlTest, UpdateWaitExitsNonZeroWhenTheJobIsCancelled) {
@@ -296,7 +284,9 @@ TEST_F(FremenctlTest, UpdateWaitExitsNonZeroWhenTheJobIsCancelled) {
   // fremenctl joins the queued job (RunUpdate answers the running one) and follows it.
   const std::string err_path = dir_.Path("wait.err");
   auto waiting = std::async(std::launch::async, [&] {
-    return Run("update --map small --wait --poll-interval 0.02 --line-interval 0", "", err_path);
+    RunOptions options;
+    options.stderr_copy_path = err_path;
+    return Run({"update", "--map", "small", "--wait", "--poll-interval", "0.02", "--line-interval", "0"}, options);
   });
   // Once it has printed its first progress line, cancel the job under it.
   const absl::Time give_up = absl::Now() + absl::Seconds(60);
@@ -306,7 +296,7 @@ TEST_F(FremenctlTest, UpdateWaitExitsNonZeroWhenTheJobIsCancelled) {
   ASSERT_THAT(ReadAll(err_path), HasSubstr("update of small: queued"));
   auto cancelled = client_->CancelOperation("small", queued->name());
   ASSERT_TRUE(cancelled.ok()) << cancelled.status();
-  const Result r = waiting.get();
+  const RunResult r = waiting.get();
   EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_THAT(r.err, HasSubstr(absl::StrCat("update of small (", queued->name(), ") was cancelled")));
 }
@@ -316,51 +306,51 @@ TEST_F(FremenctlTest, UpdateWaitExitsNonZeroWhenTheJobIsCancelled) {
 TEST_F(FremenctlTest, BackupAndRestore) {
   CreateGrid("lab");
   IngestTwoWeeks("lab");
-  Result backup = Run("backup --map lab --to nightly/lab");
+  RunResult backup = Run({"backup", "--map", "lab", "--to", "nightly/lab"});
   ASSERT_EQ(backup.exit_code, 0) << backup.err;
   EXPECT_THAT(backup.out, HasSubstr("backed up map lab to " + dir_.Path("backups") + "/nightly/lab"));
-  Result restore = Run("restore --from nightly/lab --as lab-copy");
+  RunResult restore = Run({"restore", "--from", "nightly/lab", "--as", "lab-copy"});
   ASSERT_EQ(restore.exit_code, 0) << restore.err;
   EXPECT_THAT(restore.out, HasSubstr("restored map lab-copy from nightly/lab"));
-  EXPECT_THAT(Run("stats --map lab-copy").out, HasSubstr("observations: 336"));
+  EXPECT_THAT(Run({"stats", "--map", "lab-copy"}).out, HasSubstr("observations: 336"));
 }
 
 TEST_F(FremenctlTest, BackupAndRestoreBadInputSayWhatToFix) {
   CreateGrid("lab");
-  ASSERT_EQ(Run("backup --map lab --to once").exit_code, 0);
-  Result again = Run("backup --map lab --to once");
+  ASSERT_EQ(Run({"backup", "--map", "lab", "--to", "once"}).exit_code, 0);
+  RunResult again = Run({"backup", "--map", "lab", "--to", "once"});
   EXPECT_EQ(again.exit_code, 1);
   EXPECT_THAT(again.err, HasSubstr("pick a new directory name"));
-  Result escape = Run("backup --map lab --to ../outside");
+  RunResult escape = Run({"backup", "--map", "lab", "--to", "../outside"});
   EXPECT_EQ(escape.exit_code, 1);
   EXPECT_THAT(escape.err, HasSubstr("relative to the daemon's backup root"));
-  Result taken = Run("restore --from once");
+  RunResult taken = Run({"restore", "--from", "once"});
   EXPECT_EQ(taken.exit_code, 1);
   EXPECT_THAT(taken.err, HasSubstr("--as NAME"));
-  Result nothing = Run("restore --from nowhere --as x");
+  RunResult nothing = Run({"restore", "--from", "nowhere", "--as", "x"});
   EXPECT_EQ(nothing.exit_code, 1);
   EXPECT_THAT(nothing.err, HasSubstr("no backup"));
-  EXPECT_EQ(Run("backup --map lab").exit_code, 2);  // --to is required
+  EXPECT_EQ(Run({"backup", "--map", "lab"}).exit_code, 2);  // --to is required
 }
 
 // --- status and the connection options ---
 
 TEST_F(FremenctlTest, StatusDescribesTheDaemon) {
   CreateGrid("lab");
-  Result r = Run("status");
+  RunResult r = Run({"status"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("fremend 0."));
   EXPECT_THAT(r.out, HasSubstr("maps: 1"));
   EXPECT_THAT(r.out, HasSubstr("store: open"));
-  Result json = Run("status --json");
+  RunResult json = Run({"status", "--json"});
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_THAT(json.out, HasSubstr("\"map_count\":\"1\""));
 }
 
 TEST_F(FremenctlTest, BenchRunsTheIngestLoadGeneratorAgainstTheDaemon) {
   // A small run: one stream of 100-cell scans into a 10³ grid, one window of half a second.
-  Result r = Run("bench ingest -- --map bench --grid 10 --streams 1 --cells 100 --warmup 0.2 --seconds 0.5 "
-                 "--repetitions 1 --predict-calls 0");
+  RunResult r = Run({"bench", "ingest", "--", "--map", "bench", "--grid", "10", "--streams", "1", "--cells", "100",
+                     "--warmup", "0.2", "--seconds", "0.5", "--repetitions", "1", "--predict-calls", "0"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("cell-obs/s"));
   // The generator talked to this daemon: its map is there, with what it ingested.
@@ -368,22 +358,22 @@ TEST_F(FremenctlTest, BenchRunsTheIngestLoadGeneratorAgainstTheDaemon) {
   ASSERT_TRUE(stats.ok()) << stats.status();
   EXPECT_GT(stats->observations(), 0u);
 
-  Result bad = Run("bench nosuch");
+  RunResult bad = Run({"bench", "nosuch"});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_THAT(bad.err, HasSubstr("nosuch not in {ingest,query}"));
   // The generator's own usage errors are its exit code.
-  EXPECT_NE(Run("bench ingest -- --streams 0").exit_code, 0);
+  EXPECT_NE(Run({"bench", "ingest", "--", "--streams", "0"}).exit_code, 0);
 }
 
 TEST_F(FremenctlTest, UnreachableDaemonSaysToStartItOrFixTheAddress) {
   const std::string nowhere = FreeLoopbackAddress();
   // The option after the subcommand wins over FREMEN_ADDRESS.
-  Result r = Run("status --address " + nowhere + " --timeout 5");
+  RunResult r = Run({"status", "--address", nowhere, "--timeout", "5"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.err, HasSubstr("is fremend running at " + nowhere));
   EXPECT_THAT(r.err, HasSubstr("--address (or FREMEN_ADDRESS)"));
-  EXPECT_EQ(Run("status --timeout -1").exit_code, 2);
-  Result ca = Run("status --tls-ca /no/such/file.pem");
+  EXPECT_EQ(Run({"status", "--timeout", "-1"}).exit_code, 2);
+  RunResult ca = Run({"status", "--tls-ca", "/no/such/file.pem"});
   EXPECT_EQ(ca.exit_code, 2);
   EXPECT_THAT(ca.err, HasSubstr("--tls-ca"));
 }
@@ -402,10 +392,10 @@ class FremenctlTlsTest : public FremenctlTest {
 };
 
 TEST_F(FremenctlTlsTest, TlsCaConnectsWithTls) {
-  Result r = Run("status --tls-ca '" + certificate_->cert_path + "'");
+  RunResult r = Run({"status", "--tls-ca", certificate_->cert_path});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("security: TLS"));
-  Result plain = Run("status --timeout 5");
+  RunResult plain = Run({"status", "--timeout", "5"});
   EXPECT_EQ(plain.exit_code, 1);
   EXPECT_THAT(plain.err, HasSubstr("is fremend running at"));
 }
@@ -416,15 +406,15 @@ class FremenctlTokenTest : public FremenctlTest {
 };
 
 TEST_F(FremenctlTokenTest, TokensComeFromTheOptionOrTheEnvironment) {
-  Result anonymous = Run("maps list");
+  RunResult anonymous = Run({"maps", "list"});
   EXPECT_EQ(anonymous.exit_code, 1);
   EXPECT_THAT(anonymous.err, HasSubstr("pass --token (or set FREMEN_TOKEN)"));
-  Result created = Run("maps create lab --generic --token writer-token");
+  RunResult created = Run({"maps", "create", "lab", "--generic", "--token", "writer-token"});
   ASSERT_EQ(created.exit_code, 0) << created.err;
-  Result listed = Run("maps list", "FREMEN_TOKEN=reader-token");
+  RunResult listed = RunWithToken({"maps", "list"}, "reader-token");
   ASSERT_EQ(listed.exit_code, 0) << listed.err;
   EXPECT_THAT(listed.out, HasSubstr("lab"));
-  Result denied = Run("maps delete lab --yes", "FREMEN_TOKEN=reader-token");
+  RunResult denied = RunWithToken({"maps", "delete", "lab", "--yes"}, "reader-token");
   EXPECT_EQ(denied.exit_code, 1);
   EXPECT_THAT(denied.err, HasSubstr("needs a write token"));
 }

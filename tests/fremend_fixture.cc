@@ -91,13 +91,8 @@ std::optional<TestCertificate> MakeTestCertificate(const TempDir& dir) {
   return made;
 }
 
-RunResult RunFremend(const std::vector<std::string>& args) {
-  TempDir dir;
-  const std::string log_path = dir.Path("output");
-  const pid_t pid = Spawn(args, log_path);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return {ExitCodeOf(status), ReadFile(log_path)};
+RunResult RunFremend(const std::vector<std::string>& args, const RunOptions& options) {
+  return RunProgram(FREMEND_BINARY, args, options);
 }
 
 absl::StatusOr<std::unique_ptr<FremendProcess>> FremendProcess::Start(

@@ -25,13 +25,9 @@
 #include "absl/status/statusor.h"
 #include "gtest/gtest.h"
 #include "testing/temp_dir.h"
+#include "tests/process_runner.h"
 
 namespace fremen::testing {
-
-struct RunResult {
-  int exit_code = -1;  // -1: did not exit normally
-  std::string output;  // stdout and stderr
-};
 
 // A loopback port free at the time of the call ("127.0.0.1:PORT"), for a daemon that must come back
 // on the same address after a restart.
@@ -45,8 +41,8 @@ struct TestCertificate {
 };
 std::optional<TestCertificate> MakeTestCertificate(const TempDir& dir);
 
-// Runs fremend with `args` to completion (help, bad configuration, --check-config).
-RunResult RunFremend(const std::vector<std::string>& args);
+// Runs fremend with `args` to completion (help, bad configuration, --check-config, --verify).
+RunResult RunFremend(const std::vector<std::string>& args, const RunOptions& options = {});
 
 class FremendProcess {
  public:

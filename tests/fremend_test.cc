@@ -106,14 +106,14 @@ TEST_F(FremendTest, SigintStopsCleanlyWithExitCodeZero) {
 TEST_F(FremendTest, ASecondDaemonCannotTakeTheSamePort) {
   TempDir other;
   const RunResult result = RunFremend({"--listen", daemon_->address(), "--data-dir", other.Path("data")});
-  EXPECT_EQ(result.exit_code, 1) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("cannot listen on " + daemon_->address()));
+  EXPECT_EQ(result.exit_code, 1) << Describe(result) << "\n" << result.err;
+  EXPECT_THAT(result.err, HasSubstr("cannot listen on " + daemon_->address()));
 }
 
 TEST_F(FremendTest, ASecondDaemonCannotOpenTheSameDataDirectory) {
   const RunResult result = RunFremend({"--listen", "127.0.0.1:0", "--data-dir", data_dir()});
-  EXPECT_EQ(result.exit_code, 1) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("is in use by another fremend (pid " + std::to_string(daemon_->pid()) + ")"));
+  EXPECT_EQ(result.exit_code, 1) << Describe(result) << "\n" << result.err;
+  EXPECT_THAT(result.err, HasSubstr("is in use by another fremend (pid " + std::to_string(daemon_->pid()) + ")"));
   // The first daemon serves on.
   HealthResponse::ServingStatus serving;
   ASSERT_TRUE(Health("", &serving).ok());
@@ -138,27 +138,28 @@ TEST_F(FremendTest, ConfigFileSettingsApply) {
 
 TEST(FremendCommandLineTest, HelpExitsZero) {
   const RunResult result = RunFremend({"--help"});
-  EXPECT_EQ(result.exit_code, 0);
-  EXPECT_THAT(result.output, HasSubstr("--listen"));
-  EXPECT_THAT(result.output, HasSubstr("--data-dir"));
-  EXPECT_THAT(result.output, HasSubstr("--config"));
+  EXPECT_EQ(result.exit_code, 0) << Describe(result) << "\n" << result.err;
+  EXPECT_THAT(result.out, HasSubstr("--listen"));
+  EXPECT_THAT(result.out, HasSubstr("--data-dir"));
+  EXPECT_THAT(result.out, HasSubstr("--config"));
+  EXPECT_EQ(result.err, "");
 }
 
 TEST(FremendCommandLineTest, BadConfigurationExitsTwoNamingTheSetting) {
   RunResult result = RunFremend({"--listen", "abc"});
   EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.output, HasSubstr("config: listen: \"abc\" is not HOST:PORT"));
+  EXPECT_THAT(result.err, HasSubstr("config: listen: \"abc\" is not HOST:PORT"));
 
   TempDir dir;
   const std::string config = dir.Write("bad.conf", "listen = 127.0.0.1:0\nupdate_schedule = 0 25 * * *\n");
   result = RunFremend({"--config", config});
   EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.output, HasSubstr("config: update_schedule: hour: 25 is outside [0, 23]"));
-  EXPECT_THAT(result.output, HasSubstr("bad.conf line 2"));
+  EXPECT_THAT(result.err, HasSubstr("config: update_schedule: hour: 25 is outside [0, 23]"));
+  EXPECT_THAT(result.err, HasSubstr("bad.conf line 2"));
 
   result = RunFremend({"--config", dir.Path("missing.conf")});
   EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.output, HasSubstr("missing.conf"));
+  EXPECT_THAT(result.err, HasSubstr("missing.conf"));
 
   result = RunFremend({"--no-such-flag"});
   EXPECT_EQ(result.exit_code, 2);
@@ -169,7 +170,7 @@ TEST(FremendCommandLineTest, UnwritableDataDirectoryExitsOne) {
   const std::string file = dir.Write("not-a-directory", "");
   const RunResult result = RunFremend({"--listen", "127.0.0.1:0", "--data-dir", file + "/data"});
   EXPECT_EQ(result.exit_code, 1);
-  EXPECT_THAT(result.output, HasSubstr("data_dir: cannot create"));
+  EXPECT_THAT(result.err, HasSubstr("data_dir: cannot create"));
 }
 
 // --- bearer tokens ---
