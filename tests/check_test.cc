@@ -273,7 +273,7 @@ TEST_F(CheckTest, FremenctlSalvageServesWhatSurvivedAndLeavesTheDamagedMap) {
   ASSERT_EQ(status->failed_maps_size(), 1);
   ASSERT_EQ(status->failed_maps(0).map(), "lab");
 
-  const Result r = Fremenctl("salvage lab");
+  const RunResult r = Fremenctl({"salvage", "lab"});
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_THAT(r.out, HasSubstr("map lab salvaged as lab-salvaged: "));
   EXPECT_THAT(r.out, HasSubstr("map lab: lost: shard-0/data.mdb: "));
@@ -294,7 +294,7 @@ TEST_F(CheckTest, FremenctlSalvageServesWhatSurvivedAndLeavesTheDamagedMap) {
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << refused.error_message();
   EXPECT_THAT(refused.error_message(), HasSubstr("map lab-salvaged is not damaged"));
   // The JSON report of another salvage (to another name) counts what the first one kept.
-  const Result json = Fremenctl("salvage lab --to lab-2 --json");
+  const RunResult json = Fremenctl({"salvage", "lab", "--to", "lab-2", "--json"});
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_THAT(json.out, HasSubstr("\"name\":\"lab-2\""));
   auto second = client_->SalvageMap("lab", "lab-3");
@@ -337,7 +337,7 @@ TEST_F(CheckTest, FremenctlSalvageServesWhatSurvivedAndLeavesTheDamagedMap) {
   StopDaemon();
   Start();
   ASSERT_FALSE(HasFatalFailure());
-  EXPECT_EQ(Fremenctl("check lab-salvaged").exit_code, 0);
+  EXPECT_EQ(Fremenctl({"check", "lab-salvaged"}).exit_code, 0);
 }
 
 }  // namespace
