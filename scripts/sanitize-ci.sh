@@ -13,15 +13,25 @@ tests=("$@")
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFREMEN_SANITIZE="$sanitizer" >/dev/null
 cmake --build "$build_dir" -j"$jobs" --target "${tests[@]}"
 
-export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:detect_stack_use_after_return=1}
+# No detect_stack_use_after_return: with it, g++ 12's ASan code for a frame realigned for AVX-512
+# (-march=native) addresses the fake stack through a 32-bit constant and crashes in the test
+# itself (seen in SalvageTest.ALostCheckpointLsn…: `mov $0xfffffbc8,%ebx; vmovdqa64 ...(%rbx)`).
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/tsan.supp}
 
 # Under TSan, the tests that run a real gRPC server (IngestStreamTest) are left out: Debian's gRPC
 # is not built with TSan, so every handoff through its completion queues is reported as a race
 # (scripts/tsan.supp holds the ones inside its libraries; those inlined from its headers remain).
+# Under both, MapStoreUpdateTest.IngestAndQueriesContinueDuringAPublication… is left out: whether a
+# batch is acknowledged while the publication runs depends on how long a slice takes against one
+# batch's log sync, and a sanitizer's slowdown tips that balance (it failed so under ASan on a busy
+# machine). The plain build runs it; making it independent of timing is open work.
+timing_dependent=MapStoreUpdateTest.IngestAndQueriesContinueDuringAPublicationThatEqualsItsReplay
 if [ "$sanitizer" = thread ]; then
-  export GTEST_FILTER=${GTEST_FILTER:--IngestStreamTest.*}
+  export GTEST_FILTER=${GTEST_FILTER:--IngestStreamTest.*:$timing_dependent}
+else
+  export GTEST_FILTER=${GTEST_FILTER:--$timing_dependent}
 fi
 
 logs=$(mktemp -d)
