@@ -345,7 +345,10 @@ class ShardSalvager {
   // The never-changed bricks, less any state that is also stored as changed (the changed model is
   // the newer: a state is promoted, never demoted).
   void WriteStatic() {
-    for (auto& [brick_key, brick] : static_) {
+    for (auto& entry : static_) {
+      // A named copy, not a structured binding: clang 14 does not let a lambda capture those.
+      const uint64_t brick_key = entry.first;
+      auto& brick = entry.second;
       StaticBrick kept;
       brick.ForEach([&](uint32_t i, const model::StaticState& state) {
         const uint64_t key = brick_key << kBrickBits | i;
