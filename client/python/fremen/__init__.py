@@ -7,22 +7,31 @@
             session.send(1.7e9, [1, 0], names=["front", "back"])
         print(client.predict("doors", [1.7e9 + 3600], names=["front", "back"]).probabilities)
 
-The package is the hand-written modules beside this file plus the generated messages and stubs in
-the subpackage fremen.v1 (protoc's output for proto/fremen/v1/*.proto, which imports itself as
-`fremen.v1`). The build assembles both into <build>/python/fremen; see client/python/README.md.
+Every call answers the package's own frozen dataclasses (MapInfo, Prediction, Operation, ...), each
+result of a single message keeping it as `proto`. The package is the hand-written modules beside
+this file plus the generated messages and stubs in the subpackage fremen.v1 (protoc's output for
+proto/fremen/v1/*.proto, which imports itself as `fremen.v1`) and _version.py (the project's
+version, from CMake). The build assembles them into <build>/python/fremen; see
+client/python/README.md.
 """
 
-from fremen.arrays import FlatArray
+from fremen._version import __version__
+from fremen.arrays import Array, FlatArray
 from fremen.client import DEFAULT_ADDRESS, AnomalyCheck, Client, Prediction, Reconstruction, ScoredState, connect
 from fremen.errors import (AlreadyExists, DeadlineExceeded, Error, FailedPrecondition, InvalidArgument, NotFound,
                            OutOfRange, PermissionDenied, ResourceExhausted, Unauthenticated, Unavailable)
-from fremen.ingest import Ack, IngestSession, Rejection
+from fremen.ingest import Ack, Batch, IngestSession, Rejection
+from fremen.maps import MapInfo, MapStats, MapUpdate
 from fremen.model import Component, OrderError, Persistence, StateModel
+from fremen.operations import Operation, Progress, UpdateResult
 from fremen.retry import Backoff
+from fremen.status import Backup, CheckProblem, MapScrub, ServerStatus
 
 __all__ = [
-    "DEFAULT_ADDRESS", "Ack", "AlreadyExists", "AnomalyCheck", "Backoff", "Client", "Component", "DeadlineExceeded",
-    "Error", "FailedPrecondition", "FlatArray", "IngestSession", "InvalidArgument", "NotFound", "OrderError",
-    "OutOfRange", "PermissionDenied", "Persistence", "Prediction", "Reconstruction", "Rejection", "ResourceExhausted",
-    "ScoredState", "StateModel", "Unauthenticated", "Unavailable", "connect",
+    "DEFAULT_ADDRESS", "Ack", "AlreadyExists", "AnomalyCheck", "Array", "Backoff", "Backup", "Batch", "CheckProblem",
+    "Client", "Component", "DeadlineExceeded", "Error", "FailedPrecondition", "FlatArray", "IngestSession",
+    "InvalidArgument", "MapInfo", "MapScrub", "MapStats", "MapUpdate", "NotFound", "Operation", "OrderError",
+    "OutOfRange", "PermissionDenied", "Persistence", "Prediction", "Progress", "Reconstruction", "Rejection",
+    "ResourceExhausted", "ScoredState", "ServerStatus", "StateModel", "Unauthenticated", "Unavailable",
+    "UpdateResult", "__version__", "connect",
 ]

@@ -3,14 +3,18 @@
 """
 
 import math
+from typing import TYPE_CHECKING, Any, Sequence, Union
 
 try:
     import numpy
 except ImportError:  # numpy is optional
-    numpy = None
+    numpy = None  # type: ignore[assignment]
+
+if TYPE_CHECKING:
+    import numpy.typing
 
 
-def numpy_available():
+def numpy_available() -> bool:
     return numpy is not None
 
 
@@ -20,16 +24,16 @@ class FlatArray:
     array[i, j, ...] reads one element; tolist() gives nested lists, as numpy's tolist() does.
     """
 
-    def __init__(self, values, shape):
+    def __init__(self, values: list[Any], shape: Sequence[int]) -> None:
         if len(values) != math.prod(shape):
             raise ValueError(f"{len(values)} values do not fill shape {shape}")
         self.values = values
         self.shape = tuple(shape)
 
-    def __len__(self):
+    def __len__(self) -> int:
         return self.shape[0]
 
-    def __getitem__(self, index):
+    def __getitem__(self, index: Union[int, tuple[int, ...]]) -> Any:
         if not isinstance(index, tuple):
             index = (index,)
         if len(index) != len(self.shape):
@@ -41,19 +45,24 @@ class FlatArray:
             offset = offset * n + (i % n)
         return self.values[offset]
 
-    def tolist(self):
-        def nest(values, shape):
+    def tolist(self) -> list[Any]:
+        def nest(values: list[Any], shape: tuple[int, ...]) -> list[Any]:
             if len(shape) == 1:
                 return list(values)
             step = len(values) // shape[0]
             return [nest(values[i * step:(i + 1) * step], shape[1:]) for i in range(shape[0])]
         return nest(self.values, self.shape)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"FlatArray(shape={self.shape})"
 
 
-def shaped(values, shape, dtype, use_numpy):
+# A dense result: a numpy array, or a FlatArray when numpy is not used. Both have `shape`, `[i, j]`
+# indexing and tolist().
+Array = Union["numpy.typing.NDArray[Any]", FlatArray]
+
+
+def shaped(values: Sequence[Any], shape: tuple[int, ...], dtype: str, use_numpy: bool) -> Array:
     """`values` (a sequence in C order) as a numpy array of `dtype` ("float32", "uint8", "bool") and
     `shape` when `use_numpy`, else as a FlatArray."""
     if use_numpy:
@@ -61,7 +70,7 @@ def shaped(values, shape, dtype, use_numpy):
     return FlatArray(list(values), shape)
 
 
-def shaped_bytes(data, shape, use_numpy):
+def shaped_bytes(data: bytes, shape: tuple[int, ...], use_numpy: bool) -> Array:
     """Bytes (one uint8 per element) shaped as by shaped()."""
     if use_numpy:
         return numpy.frombuffer(data, dtype=numpy.uint8).reshape(shape).copy()

@@ -13,21 +13,29 @@ IngestSession belongs to one thread.
 import dataclasses
 import math
 import secrets
+from typing import Any, Iterator, Literal, Optional, Sequence, Union
 
 import grpc
 
 from fremen import arrays, errors, refs
 from fremen.admin import AdminCalls
+from fremen.arrays import Array
 from fremen.ingest import IngestSession
+from fremen.maps import MapInfo, MapStats
 from fremen.model import StateModel
+from fremen.refs import Cells, Ids, Names, Points
 from fremen.retry import Backoff, retrying
 from fremen.v1 import (admin_pb2_grpc, common_pb2, ingest_pb2, ingest_pb2_grpc, maps_pb2, maps_pb2_grpc, query_pb2,
                        query_pb2_grpc)
 
 DEFAULT_ADDRESS = "127.0.0.1:50051"
+# Seconds, one number or many.
+Times = Union[float, Sequence[float]]
 
 
-def connect(address=DEFAULT_ADDRESS, token=None, tls=None, timeout=30.0, use_numpy=None, reconnect=Backoff()):
+def connect(address: str = DEFAULT_ADDRESS, token: Optional[str] = None, tls: Union[None, bool, str] = None,
+            timeout: Optional[float] = 30.0, use_numpy: Optional[bool] = None,
+            reconnect: Optional[Backoff] = Backoff()) -> "Client":
     """A Client of the fremend at `address` ("host:port").
 
     token: a bearer token, sent as "authorization: Bearer <token>" (needed when the daemon has
@@ -58,9 +66,9 @@ class Prediction:
     """Predict's answer. probabilities[i, j] is p of states[j] at times[i] (shape times × states);
     None when states_only. states: p ≥ confidence, same shape, when a confidence was given.
     unobserved: indices j of the states the map has never observed (they predict 0.5)."""
-    probabilities: object
-    states: object
-    unobserved: list
+    probabilities: Optional[Array]
+    states: Optional[Array]
+    unobserved: list[int]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -69,11 +77,11 @@ class Reconstruction:
     first_slot_time + k · slot_seconds: 0, 1, or UNOBSERVED (2) when nothing was observed then."""
     first_slot_time: float
     slot_seconds: float
-    slots: object
+    slots: Array
 
     UNOBSERVED = 2
 
-    def slot_times(self):
+    def slot_times(self) -> list[float]:
         """The start of every slot, seconds."""
         count = self.slots.shape[1] if len(self.slots.shape) == 2 else 0
         return [self.first_slot_time + k * self.slot_seconds for k in range(count)]
@@ -89,8 +97,8 @@ class ScoredState:
 @dataclasses.dataclass(frozen=True)
 class AnomalyCheck:
     """One element per observation checked."""
-    probabilities: list
-    anomalous: list
+    probabilities: list[float]
+    anomalous: list[bool]
 
 
 _REGION_OUTPUTS = {
@@ -109,7 +117,8 @@ _CRITERIA = {
 class Client(AdminCalls):
     """Made by fremen.connect(). Usable as a context manager (closes the channel)."""
 
-    def __init__(self, channel, token=None, timeout=30.0, use_numpy=None, reconnect=None):
+    def __init__(self, channel: grpc.Channel, token: Optional[str] = None, timeout: Optional[float] = 30.0,
+                 use_numpy: Optional[bool] = None, reconnect: Optional[Backoff] = None) -> None:
         self._channel = channel
         self._reconnect = reconnect
         self._auth = [("authorization", f"Bearer {token}")] if token else []
@@ -122,31 +131,31 @@ class Client(AdminCalls):
         self._query = query_pb2_grpc.QueryServiceStub(channel)
         self._admin = admin_pb2_grpc.AdminServiceStub(channel)
 
-    def close(self):
+    def close(self) -> None:
         self._channel.close()
 
-    def __enter__(self):
+    def __enter__(self) -> "Client":
         return self
 
-    def __exit__(self, *exc_info):
+    def __exit__(self, *exc_info: object) -> Literal[False]:
         self.close()
         return False
 
     # --- plumbing ---
 
-    def _metadata(self, map_name=None):
+    def _metadata(self, map_name: Optional[str] = None) -> list[tuple[str, str]]:
         return self._auth + ([("x-fremen-map", map_name)] if map_name else [])
 
-    def _call(self, method, request, map_name=None, idempotent=True):
+    def _call(self, method: Any, request: Any, map_name: Optional[str] = None, idempotent: bool = True) -> Any:
         """One unary call; tried again after UNAVAILABLE (within the backoff) when `idempotent`."""
-        def attempt():
+        def attempt() -> Any:
             try:
                 return method(request, metadata=self._metadata(map_name), timeout=self._timeout)
             except grpc.RpcError as error:
                 raise errors.error_from_rpc(error) from None
         return retrying(self._reconnect if idempotent else None, attempt)
 
-    def _channel_ready(self, timeout):
+    def _channel_ready(self, timeout: float) -> bool:
         """Whether the channel is connected (or connects) within `timeout` seconds."""
         future = grpc.channel_ready_future(self._channel)
         try:
@@ -156,7 +165,7 @@ class Client(AdminCalls):
             future.cancel()  # stops watching the channel
             return False
 
-    def _pages(self, method, request, field, map_name=None):
+    def _pages(self, method: Any, request: Any, field: str, map_name: Optional[str] = None) -> Iterator[Any]:
         """Every element of the repeated `field` over all the pages of a List call."""
         while True:
             page = self._call(method, request, map_name)
@@ -167,10 +176,15 @@ class Client(AdminCalls):
 
     # --- maps ---
 
-    def create_map(self, name, *, size=None, resolution=None, origin=None, kind=None, longest_period=None,
-                   period_count=None, floor_periods=False, periods=None, max_order=None, persistence=None,
-                   error_half_life=None, criterion=None, lossless_sampling=0.0, lossless_origin=0.0, shards=0):
-        """Creates a map and returns it (a fremen.v1.Map with every default filled in).
+    def create_map(self, map_name: str, *, size: Optional[Sequence[int]] = None, resolution: Optional[float] = None,
+                   origin: Optional[Sequence[float]] = None, kind: Optional[str] = None,
+                   longest_period: Optional[float] = None, period_count: Optional[int] = None,
+                   floor_periods: bool = False, periods: Optional[Sequence[float]] = None,
+                   max_order: Optional[int] = None, persistence: Optional[bool] = None,
+                   error_half_life: Optional[float] = None, criterion: Optional[str] = None,
+                   lossless_sampling: float = 0.0, lossless_origin: float = 0.0, shards: int = 0) -> MapInfo:
+        """Creates a map and returns its MapInfo (every default filled in; its fields are named as
+        these parameters).
 
         A grid map when `size` is given: (nx, ny) or (nx, ny, nz) cells of `resolution` metres from
         `origin` (x, y[, z]) metres; a generic map (states by id or name) otherwise. `kind` ("grid"
@@ -185,7 +199,7 @@ class Client(AdminCalls):
         kinds = {"grid": maps_pb2.MAP_KIND_GRID, "generic": maps_pb2.MAP_KIND_GENERIC}
         if kind not in kinds:
             raise errors.InvalidArgument(f"kind must be 'grid' or 'generic', got {kind!r}")
-        spec = maps_pb2.Map(name=name, kind=kinds[kind], lossless_sampling_seconds=lossless_sampling,
+        spec = maps_pb2.Map(name=map_name, kind=kinds[kind], lossless_sampling_seconds=lossless_sampling,
                             lossless_origin=lossless_origin, shards=shards)
         if kind == "grid":
             if size is None or resolution is None:
@@ -213,23 +227,26 @@ class Client(AdminCalls):
             if criterion not in _CRITERIA:
                 raise errors.InvalidArgument(f"criterion must be 'threshold' or 'squared', got {criterion!r}")
             spec.criterion = _CRITERIA[criterion]
-        return self._call(self._maps.CreateMap, maps_pb2.CreateMapRequest(map=spec), name, idempotent=False).map
+        request = maps_pb2.CreateMapRequest(map=spec)
+        return MapInfo.from_proto(self._call(self._maps.CreateMap, request, map_name, idempotent=False).map)
 
-    def get_map(self, name):
-        """The map (fremen.v1.Map). NotFound when there is none."""
-        return self._call(self._maps.GetMap, maps_pb2.GetMapRequest(map=name), name).map
+    def get_map(self, map_name: str) -> MapInfo:
+        """The map's MapInfo. NotFound when there is none."""
+        return MapInfo.from_proto(self._call(self._maps.GetMap, maps_pb2.GetMapRequest(map=map_name), map_name).map)
 
-    def list_maps(self, page_size=0):
-        """Every map (fremen.v1.Map) in name order, fetched a page of `page_size` at a time."""
-        yield from self._pages(self._maps.ListMaps, maps_pb2.ListMapsRequest(page_size=page_size), "maps")
+    def list_maps(self, page_size: int = 0) -> Iterator[MapInfo]:
+        """Every map's MapInfo in name order, fetched a page of `page_size` at a time."""
+        for message in self._pages(self._maps.ListMaps, maps_pb2.ListMapsRequest(page_size=page_size), "maps"):
+            yield MapInfo.from_proto(message)
 
-    def delete_map(self, name):
+    def delete_map(self, map_name: str) -> None:
         """Deletes the map and all its data. NotFound when there is none."""
-        self._call(self._maps.DeleteMap, maps_pb2.DeleteMapRequest(map=name), name, idempotent=False)
+        self._call(self._maps.DeleteMap, maps_pb2.DeleteMapRequest(map=map_name), map_name, idempotent=False)
 
     # --- ingest ---
 
-    def ingest(self, map_name, writer_id=None, first_sequence=None, max_in_flight=64, timeout=None, resume=True):
+    def ingest(self, map_name: str, writer_id: Optional[int] = None, first_sequence: Optional[int] = None,
+               max_in_flight: int = 64, timeout: Optional[float] = None, resume: bool = True) -> IngestSession:
         """An IngestSession streaming batches into `map_name`.
 
         (writer_id, sequence) names a batch: a robot that reconnects and resends batches not yet
@@ -251,23 +268,25 @@ class Client(AdminCalls):
                              max_in_flight, timeout, reconnect=self._reconnect if resume else None,
                              channel_ready=self._channel_ready)
 
-    def last_sequence(self, map_name, writer_id):
+    def last_sequence(self, map_name: str, writer_id: int) -> int:
         """The highest sequence number of `writer_id` the map has taken (0: none): a writer that
         lost its count continues one above it."""
         request = ingest_pb2.LastSequenceRequest(map=map_name, writer_id=writer_id)
-        return self._call(self._ingest.LastSequence, request, map_name).last_sequence
+        sequence: int = self._call(self._ingest.LastSequence, request, map_name).last_sequence
+        return sequence
 
     # --- queries ---
 
-    def predict(self, map_name, times, *, ids=None, names=None, cells=None, points=None, persistence=False,
-                order=None, confidence=None, states_only=False):
+    def predict(self, map_name: str, times: Times, *, ids: Optional[Ids] = None, names: Optional[Names] = None,
+                cells: Optional[Cells] = None, points: Optional[Points] = None, persistence: bool = False,
+                order: Optional[int] = None, confidence: Optional[float] = None,
+                states_only: bool = False) -> Prediction:
         """p(t) of many states (exactly one of ids=, names=, cells=, points=) at many `times` (a
         number or a sequence, seconds). persistence: blend in the last observation (maps created
         with persistence). order: evaluate at this order instead of each state's selected one.
         confidence: also answer p ≥ confidence; states_only: only that."""
-        times = [float(times)] if isinstance(times, (int, float)) else [float(t) for t in times]
         request = query_pb2.PredictRequest(map=map_name, states=refs.state_refs("predict", ids, names, cells, points),
-                                           times=times, options=refs.prediction_options(persistence, order),
+                                           times=_seconds(times), options=refs.prediction_options(persistence, order),
                                            states_only=states_only)
         if confidence is not None:
             request.confidence = confidence
@@ -281,8 +300,9 @@ class Client(AdminCalls):
             states = arrays.shaped(response.states, shape, "bool", self._use_numpy)
         return Prediction(probabilities, states, list(response.unobserved))
 
-    def region(self, map_name, lo, hi, time, *, output="float", confidence=0.0, persistence=False, order=None,
-               chunk_cells=0):
+    def region(self, map_name: str, lo: Sequence[int], hi: Sequence[int], time: float, *, output: str = "float",
+               confidence: float = 0.0, persistence: bool = False, order: Optional[int] = None,
+               chunk_cells: int = 0) -> Array:
         """A box [lo, hi) of a grid at `time`, assembled from the daemon's chunks.
 
         lo, hi: (x, y) on a 2-D grid, giving an array of shape (ny, nx); or (x, y, z), giving
@@ -302,11 +322,11 @@ class Client(AdminCalls):
             hi=common_pb2.CellIndex(x=hi3[0], y=hi3[1], z=hi3[2]), time=time,
             options=refs.prediction_options(persistence, order), output=kind, confidence=confidence,
             chunk_cells=chunk_cells)
-        extent = [max(h - l, 0) for l, h in zip(lo, hi)]
+        extent = [max(high - low, 0) for low, high in zip(lo, hi)]
         floats = dtype == "float32"
 
-        def attempt():  # the whole stream again after UNAVAILABLE: a read
-            values = None
+        def attempt() -> Union[list[float], bytearray]:  # the whole stream again after UNAVAILABLE: a read
+            values: Union[list[float], bytearray, None] = None
             filled = 0
             try:
                 for chunk in self._query.PredictRegion(request, metadata=self._metadata(map_name),
@@ -325,24 +345,26 @@ class Client(AdminCalls):
 
         values = retrying(self._reconnect, attempt)
         shape = tuple(reversed(extent))
-        if floats:
-            return arrays.shaped(values, shape, dtype, self._use_numpy)
-        return arrays.shaped_bytes(bytes(values), shape, self._use_numpy)
+        if isinstance(values, bytearray):
+            return arrays.shaped_bytes(bytes(values), shape, self._use_numpy)
+        return arrays.shaped(values, shape, dtype, self._use_numpy)
 
-    def model(self, map_name, *, id=None, name=None, cell=None, point=None, include_spectrum=False,  # noqa: A002
-              raw=False):
-        """One state's model (exactly one of id=, name=, cell=, point=) as a fremen.StateModel, or
-        the fremen.v1.StateModel when raw; None when the state was never observed."""
+    def model(self, map_name: str, *, id: Optional[int] = None, name: Optional[str] = None,  # noqa: A002
+              cell: Optional[Sequence[int]] = None, point: Optional[Sequence[float]] = None,
+              include_spectrum: bool = False) -> Optional[StateModel]:
+        """One state's StateModel (exactly one of id=, name=, cell=, point=; its `proto` is the
+        fremen.v1.StateModel, with the lossless history's details); None when the state was never
+        observed."""
         request = query_pb2.GetStateModelRequest(map=map_name, state=refs.state_ref("model", id, name, cell, point),
                                                  include_spectrum=include_spectrum)
         response = self._call(self._query.GetStateModel, request, map_name)
         if not response.HasField("model"):
             return None
-        if raw:
-            return response.model
         return StateModel.from_proto(response.model)
 
-    def reconstruct(self, map_name, start, end, *, ids=None, names=None, cells=None, points=None):
+    def reconstruct(self, map_name: str, start: float, end: float, *, ids: Optional[Ids] = None,
+                    names: Optional[Names] = None, cells: Optional[Cells] = None,
+                    points: Optional[Points] = None) -> Reconstruction:
         """The exact past states of a lossless map (created with lossless_sampling > 0) in the
         sampling slots overlapping [start, end) seconds, of the states named (exactly one of ids=,
         names=, cells=, points=): a Reconstruction whose slots[state, slot] is 0, 1 or 2 =
@@ -357,25 +379,35 @@ class Client(AdminCalls):
         slots = arrays.shaped_bytes(data, (len(response.histories), count), self._use_numpy)
         return Reconstruction(response.first_slot_time, response.slot_seconds, slots)
 
-    def stats(self, map_name):
-        """The map's statistics (fremen.v1.MapStats: states, observations, bytes, orders, errors)."""
-        return self._call(self._query.GetMapStats, query_pb2.GetMapStatsRequest(map=map_name), map_name).stats
+    def stats(self, map_name: str) -> MapStats:
+        """The map's MapStats: states, observations, bytes, orders, errors, its last update."""
+        request = query_pb2.GetMapStatsRequest(map=map_name)
+        return MapStats.from_proto(self._call(self._query.GetMapStats, request, map_name).stats)
 
-    def top(self, map_name, group, time, n=10, *, persistence=False, order=None):
+    def top(self, map_name: str, group: str, time: float, n: int = 10, *, persistence: bool = False,
+            order: Optional[int] = None) -> list[ScoredState]:
         """The n states of `group` most likely to be 1 at `time`, most likely first (generic maps)."""
         request = query_pb2.TopStatesRequest(map=map_name, group=group, time=time, n=n,
                                              options=refs.prediction_options(persistence, order))
         response = self._call(self._query.TopStates, request, map_name)
         return [ScoredState(s.id, s.name, s.probability) for s in response.states]
 
-    def anomalies(self, map_name, values, times, confidence, *, ids=None, names=None, cells=None, points=None,
-                  persistence=False, order=None):
+    def anomalies(self, map_name: str, values: Sequence[float], times: Times, confidence: float, *,
+                  ids: Optional[Ids] = None, names: Optional[Names] = None, cells: Optional[Cells] = None,
+                  points: Optional[Points] = None, persistence: bool = False,
+                  order: Optional[int] = None) -> AnomalyCheck:
         """Which observations (`values` of the states named, at `times`: one per state or a single
         one) are anomalous at `confidence` in [0.5, 1]."""
-        times = [float(times)] if isinstance(times, (int, float)) else [float(t) for t in times]
         request = query_pb2.CheckAnomaliesRequest(
             map=map_name, states=refs.state_refs("anomalies", ids, names, cells, points),
-            values=[float(v) for v in values], times=times, confidence=confidence,
+            values=[float(v) for v in values], times=_seconds(times), confidence=confidence,
             options=refs.prediction_options(persistence, order))
         response = self._call(self._query.CheckAnomalies, request, map_name)
         return AnomalyCheck(list(response.probabilities), list(response.anomalous))
+
+
+def _seconds(times: Times) -> list[float]:
+    """One time or many as the list the requests carry."""
+    if isinstance(times, (int, float)):
+        return [float(times)]
+    return [float(t) for t in times]

@@ -12,7 +12,7 @@ import grpc
 class Error(Exception):
     """A failed call. `code` is a grpc.StatusCode, `message` the server's (or client's) message."""
 
-    def __init__(self, code, message):
+    def __init__(self, code: grpc.StatusCode, message: str) -> None:
         super().__init__(f"{code.name}: {message}")
         self.code = code
         self.message = message
@@ -21,7 +21,7 @@ class Error(Exception):
 class InvalidArgument(Error, ValueError):
     """A bad argument or field; the message names it."""
 
-    def __init__(self, message):
+    def __init__(self, message: str) -> None:
         super().__init__(grpc.StatusCode.INVALID_ARGUMENT, message)
 
 
@@ -61,7 +61,7 @@ class DeadlineExceeded(Error):
     """The call did not finish within its timeout."""
 
 
-_CLASS_OF_CODE = {
+_CLASS_OF_CODE: dict[grpc.StatusCode, type[Error]] = {
     grpc.StatusCode.NOT_FOUND: NotFound,
     grpc.StatusCode.ALREADY_EXISTS: AlreadyExists,
     grpc.StatusCode.UNAUTHENTICATED: Unauthenticated,
@@ -76,20 +76,18 @@ _CLASS_OF_CODE = {
 _CODE_OF_NUMBER = {code.value[0]: code for code in grpc.StatusCode}
 
 
-def error_for(code, message):
+def error_for(code: grpc.StatusCode, message: str) -> Error:
     """The Error (of the most specific class) for a grpc.StatusCode and a message."""
     if code == grpc.StatusCode.INVALID_ARGUMENT:
-        error = InvalidArgument(message)
-    else:
-        error = _CLASS_OF_CODE.get(code, Error)(code, message)
-    return error
+        return InvalidArgument(message)
+    return _CLASS_OF_CODE.get(code, Error)(code, message)
 
 
-def error_from_status(number, message):
+def error_from_status(number: int, message: str) -> Error:
     """The Error for a status carried inside a response (fremen.v1.Status: a numeric code)."""
     return error_for(_CODE_OF_NUMBER.get(number, grpc.StatusCode.UNKNOWN), message)
 
 
-def error_from_rpc(rpc_error):
+def error_from_rpc(rpc_error: grpc.RpcError) -> Error:
     """The Error for a grpc.RpcError raised by a stub."""
     return error_for(rpc_error.code(), rpc_error.details() or "")

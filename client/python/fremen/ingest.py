@@ -37,12 +37,18 @@ import dataclasses
 import queue
 import threading
 import time as time_module
+from types import TracebackType
+from typing import Any, Callable, Iterable, Iterator, Literal, Optional, Sequence, Union
 
 import grpc
 
-from fremen import errors, refs
+from fremen import errors, proto_values, refs
+from fremen.refs import Cells, Ids, Names, Points
+from fremen.retry import Backoff
 from fremen.v1 import common_pb2, ingest_pb2
 
+# A batch as sent: what unanswered() gives and resend() takes (opaque to callers, who pass it on).
+Batch = ingest_pb2.IngestRequest
 _END = object()  # ends the request iterator
 # Seconds a stream's answers may take to end after its call ended before the stream counts as
 # failed with the call's status (see _read_stream).
@@ -51,8 +57,8 @@ STUCK_GRACE = 5.0
 
 @dataclasses.dataclass(frozen=True)
 class Rejection:
-    """One observation not applied: its position in the batch and why ("VALUE_OUT_OF_RANGE",
-    "OUTSIDE_MAP")."""
+    """One observation not applied: its position in the batch and why ("value_out_of_range",
+    "outside_map")."""
     index: int
     reason: str
 
@@ -64,35 +70,32 @@ class Ack:
     accepted: int
     rejected: int
     duplicate: bool  # a retry of a batch applied before: nothing applied this time
-    rejections: list  # the first Rejection objects (at most 16)
-    error: object  # a fremen.Error when the batch was refused as a whole, else None
+    rejections: list[Rejection]  # the first ones (at most 16)
+    error: Optional[errors.Error]  # when the batch was refused as a whole
 
     @property
-    def ok(self):
+    def ok(self) -> bool:
         return self.error is None
 
     @classmethod
-    def from_proto(cls, response):
-        error = None
-        if response.HasField("error") and response.error.code != 0:
-            error = errors.error_from_status(response.error.code, response.error.message)
-        rejections = [
-            Rejection(r.index, ingest_pb2.RejectReason.Name(r.reason).removeprefix("REJECT_REASON_"))
-            for r in response.rejections
-        ]
+    def from_proto(cls, response: ingest_pb2.IngestResponse) -> "Ack":
+        error = proto_values.error(response.error) if response.HasField("error") else None
+        rejections = [Rejection(r.index, proto_values.word(ingest_pb2.RejectReason, r.reason, "REJECT_REASON_"))
+                      for r in response.rejections]
         return cls(response.sequence, response.accepted, response.rejected, response.duplicate, rejections, error)
 
 
 class IngestSession:
     """Made by Client.ingest(); use as a context manager or call close()."""
 
-    def __init__(self, ingest_method, map_name, metadata, writer_id, first_sequence, max_in_flight, timeout,
-                 reconnect=None, channel_ready=None):
+    def __init__(self, ingest_method: Any, map_name: str, metadata: list[tuple[str, str]], writer_id: int,
+                 first_sequence: int, max_in_flight: int, timeout: Optional[float], reconnect: Optional[Backoff] = None,
+                 channel_ready: Optional[Callable[[float], bool]] = None) -> None:
         """reconnect: the fremen.Backoff to resume with after UNAVAILABLE (None = do not resume);
         channel_ready(timeout): whether the channel is connected within `timeout` seconds."""
         if max_in_flight < 1:
             raise errors.InvalidArgument(f"max_in_flight must be at least 1, got {max_in_flight}")
-        self.map = map_name
+        self.map_name = map_name
         self.writer_id = writer_id
         # The sequence number the next send() uses unless told otherwise.
         self.next_sequence = first_sequence
@@ -100,57 +103,63 @@ class IngestSession:
         self._reconnect = reconnect
         self._channel_ready = channel_ready
         self._deadline = None if timeout is None else time_module.monotonic() + timeout
-        self._open_call = lambda requests, timeout: ingest_method(requests, metadata=metadata, timeout=timeout)
+        self._open_call: Callable[[Iterator[Batch], Optional[float]], Any] = (
+            lambda requests, timeout: ingest_method(requests, metadata=metadata, timeout=timeout))
         self._lock = threading.Condition()
-        self._unanswered = collections.deque()  # batches sent, oldest first, not yet answered
-        self._new_acks = []
-        self._failure = None  # the fremen.Error that ended the session
+        self._unanswered: collections.deque[Batch] = collections.deque()  # sent, oldest first, not yet answered
+        self._new_acks: list[Ack] = []
+        self._failure: Optional[errors.Error] = None  # the fremen.Error that ended the session
         self._ended = False  # the reader is done: no more answers will come
         self._closed = False
         self._cancelled = threading.Event()
         self._reconnects = 0
-        self._requests = queue.Queue()  # the current stream's
+        self._requests: queue.Queue[Any] = queue.Queue()  # the current stream's: batches, then _END
         self._call = self._open_stream(self._requests)
         self._reader = threading.Thread(target=self._read_acks, name=f"fremen-ingest-{map_name}", daemon=True)
         self._reader.start()
 
     # --- sending ---
 
-    def send(self, time, values, *, ids=None, names=None, groups=None, cells=None, points=None, sequence=None):
+    def send(self, time: float, values: Iterable[float], *, ids: Optional[Ids] = None, names: Optional[Names] = None,
+             groups: Optional[Iterable[str]] = None, cells: Optional[Cells] = None, points: Optional[Points] = None,
+             sequence: Optional[int] = None) -> int:
         """Sends one batch: observations `values` (each in [0, 1]) at `time` (seconds) of the states
         named by exactly one of ids= / names= (generic maps; groups= optionally labels each state
         the first time it is seen) or cells= / points= (grid maps). sequence: the batch's number
         instead of the next one (later batches continue above it). Returns its sequence number."""
-        request = ingest_pb2.IngestRequest(map=self.map, writer_id=self.writer_id, time=time)
-        values = [float(v) for v in values]
+        request = ingest_pb2.IngestRequest(map=self.map_name, writer_id=self.writer_id, time=time)
+        floats = [float(v) for v in values]
         kind = refs.chosen_kind({"ids": ids, "names": names, "cells": cells, "points": points}, "send")
         if groups is not None and kind not in ("ids", "names"):
             raise errors.InvalidArgument("groups= labels generic states (ids= or names=), not grid cells")
-        groups = list(groups) if groups is not None else []
-        if kind == "ids":
+        labels = list(groups) if groups is not None else []
+        if ids is not None:
             request.states.ids.extend(int(i) for i in ids)
-            request.states.values.extend(values)
-            request.states.groups.extend(groups)
-        elif kind == "names":
+            request.states.values.extend(floats)
+            request.states.groups.extend(labels)
+        elif names is not None:
             request.named_states.names.extend(names)
-            request.named_states.values.extend(values)
-            request.named_states.groups.extend(groups)
-        elif kind == "cells":
+            request.named_states.values.extend(floats)
+            request.named_states.groups.extend(labels)
+        elif cells is not None:
             request.cells.cells.CopyFrom(refs.cell_indices(cells))
-            request.cells.values.extend(values)
+            request.cells.values.extend(floats)
         else:
+            assert points is not None  # chosen_kind saw exactly one given
             request.points.points.CopyFrom(refs.points(points))
-            request.points.values.extend(values)
+            request.points.values.extend(floats)
         return self._put(request, sequence)
 
-    def send_patch(self, time, origin, size, *, values=None, probabilities=None, sequence=None):
+    def send_patch(self, time: float, origin: Sequence[int], size: Sequence[int], *, values: Optional[Any] = None,
+                   probabilities: Optional[Union[bytes, bytearray, Sequence[int]]] = None,
+                   sequence: Optional[int] = None) -> int:
         """Sends a dense box of a grid map: `origin` (x, y[, z]) its first cell, `size` (nx, ny[, nz])
         its cells, and either `values` (floats in [0, 1], x fastest, then y, then z; a numpy array
         of shape (nz, ny, nx) or (ny, nx) is flattened in that order) or `probabilities` (bytes, one
         per cell, s = byte / 255). Returns its sequence number."""
         if (values is None) == (probabilities is None):
             raise errors.InvalidArgument("send_patch needs exactly one of values= and probabilities=")
-        request = ingest_pb2.IngestRequest(map=self.map, writer_id=self.writer_id, time=time)
+        request = ingest_pb2.IngestRequest(map=self.map_name, writer_id=self.writer_id, time=time)
         o = list(origin) + [0] * (3 - len(origin))
         s = list(size) + [1] * (3 - len(size))
         request.patch.origin.CopyFrom(common_pb2.CellIndex(x=o[0], y=o[1], z=o[2]))
@@ -158,11 +167,11 @@ class IngestSession:
         if values is not None:
             flat = values.ravel() if hasattr(values, "ravel") else values
             request.patch.values.extend(float(v) for v in flat)
-        else:
+        elif probabilities is not None:
             request.patch.probabilities = bytes(probabilities)
         return self._put(request, sequence)
 
-    def resend(self, batches):
+    def resend(self, batches: Iterable[Batch]) -> None:
         """Sends again batches that another session of the same writer sent but never saw answered
         (its unanswered() after the stream failed), with their own sequence numbers: the daemon
         applies those it lacks and answers the others with duplicate=True, so that nothing is lost
@@ -174,16 +183,16 @@ class IngestSession:
                     f"{self.writer_id}: open it with ingest(..., writer_id={batch.writer_id})")
             request = ingest_pb2.IngestRequest()
             request.CopyFrom(batch)
-            request.map = self.map
+            request.map = self.map_name
             self._put(request, request.sequence)
 
-    def unanswered(self):
-        """The batches (fremen.v1.IngestRequest) sent and not answered yet, oldest first: after the
+    def unanswered(self) -> list[Batch]:
+        """The batches (fremen.v1.IngestRequest messages) sent and not answered yet, oldest first: after the
         stream failed, the ones to resend() in a new session."""
         with self._lock:
             return list(self._unanswered)
 
-    def _put(self, request, sequence):
+    def _put(self, request: Batch, sequence: Optional[int]) -> int:
         """Numbers the batch (`sequence`, or the next one when None) and queues it for the stream;
         blocks while max_in_flight batches are unanswered. The batch's sequence number."""
         with self._lock:
@@ -201,16 +210,16 @@ class IngestSession:
         return request.sequence
 
     @property
-    def reconnects(self):
+    def reconnects(self) -> int:
         """How many times the session opened a new stream after UNAVAILABLE."""
         with self._lock:
             return self._reconnects
 
     # --- streams ---
 
-    def _open_stream(self, requests):
+    def _open_stream(self, requests: "queue.Queue[Any]") -> Any:
         """Starts an Ingest call that sends what `requests` (a queue ended by _END) holds."""
-        def iterate():
+        def iterate() -> Iterator[Batch]:
             while (request := requests.get()) is not _END:
                 yield request
         timeout = None
@@ -218,7 +227,7 @@ class IngestSession:
             timeout = max(self._deadline - time_module.monotonic(), 0.001)
         return self._open_call(iterate(), timeout)
 
-    def _resume(self):
+    def _resume(self) -> bool:
         """Replaces the failed stream by a new one that starts with the unanswered batches. False
         when the session was cancelled meanwhile."""
         with self._lock:
@@ -236,18 +245,19 @@ class IngestSession:
 
     # --- acknowledgements ---
 
-    def _read_acks(self):
+    def _read_acks(self) -> None:
         """The reader thread: the answers of each stream, and a new stream after UNAVAILABLE for as
         long as the backoff allows (its count of tries starts again once a stream answered)."""
-        pauses = None
+        pauses: Optional[Iterator[float]] = None
         failure = None
         try:
             while True:
                 answered, failure = self._read_stream(self._call)
-                if not self._may_resume(failure):
+                backoff = self._reconnect
+                if backoff is None or not self._may_resume(failure):
                     break
                 if pauses is None or answered:
-                    pauses = self._reconnect.pauses()
+                    pauses = backoff.pauses()
                 if not self._await_daemon(pauses) or not self._resume():
                     break
         finally:
@@ -258,20 +268,24 @@ class IngestSession:
                 requests = self._requests
             requests.put(_END)  # the daemon is gone: stop the sender
 
-    def _await_daemon(self, pauses):
+    def _await_daemon(self, pauses: Iterator[float]) -> bool:
         """Waits, a pause at a time, until the channel is connected again; False when the pauses
         ran out or the session was cancelled. Why not simply open a stream after each pause: a
         stream that fails at once (connection refused) while gRPC sends the batches queued on it
         can leave gRPC's response iterator waiting for ever (python3-grpcio 1.51), so a new stream
-        is opened only on a connected channel."""
+        is opened only on a connected channel. A session made without channel_ready does not
+        resume."""
+        ready = self._channel_ready
+        if ready is None:
+            return False
         for pause in pauses:
-            if self._channel_ready(pause):
+            if ready(pause):
                 return not self._cancelled.is_set()
             if self._cancelled.is_set():
                 return False
         return False
 
-    def _read_stream(self, call):
+    def _read_stream(self, call: Any) -> tuple[int, Optional[errors.Error]]:
         """(answers read, the fremen.Error that ended the stream or None).
 
         The answers are read on a thread of their own because gRPC's response iterator can wait for
@@ -279,11 +293,11 @@ class IngestSession:
         once the call is done, its answers must end within STUCK_GRACE seconds, or the stream
         counts as failed with the call's status and the stuck thread is abandoned (anything it
         might still read is dropped; those batches stay unanswered and are resent)."""
-        state = {"answered": 0, "abandoned": False, "failure": None}
+        state: dict[str, Any] = {"answered": 0, "abandoned": False, "failure": None}
         finished = threading.Event()
         call_done = threading.Event()
 
-        def receive():
+        def receive() -> None:
             try:
                 for response in call:
                     with self._lock:
@@ -298,7 +312,7 @@ class IngestSession:
             finally:
                 finished.set()
 
-        threading.Thread(target=receive, name=f"fremen-ingest-answers-{self.map}", daemon=True).start()
+        threading.Thread(target=receive, name=f"fremen-ingest-answers-{self.map_name}", daemon=True).start()
         call.add_done_callback(lambda _: call_done.set())
         call_done.wait()
         if finished.wait(STUCK_GRACE):
@@ -307,15 +321,14 @@ class IngestSession:
             state["abandoned"] = True
             return state["answered"], errors.error_for(call.code(), call.details() or "the ingest stream ended")
 
-    def _may_resume(self, failure):
-        """Whether to open another stream: after UNAVAILABLE, when a backoff is set, unless the
-        session was cancelled or was closed with every batch answered (nothing left to send)."""
+    def _may_resume(self, failure: Optional[errors.Error]) -> bool:
+        """Whether to open another stream (the session having a backoff): after UNAVAILABLE, unless
+        the session was cancelled or was closed with every batch answered (nothing left to send)."""
         with self._lock:
             finished = self._closed and not self._unanswered
-        return (isinstance(failure, errors.Unavailable) and self._reconnect is not None
-                and not self._cancelled.is_set() and not finished)
+        return isinstance(failure, errors.Unavailable) and not self._cancelled.is_set() and not finished
 
-    def _raise_if_ended(self):
+    def _raise_if_ended(self) -> None:
         # Called with the lock held.
         if self._failure is not None:
             raise self._failure
@@ -323,7 +336,7 @@ class IngestSession:
             raise errors.error_for(grpc.StatusCode.UNKNOWN,
                                    f"the ingest stream ended with {len(self._unanswered)} batches unanswered")
 
-    def wait(self, timeout=None):
+    def wait(self, timeout: Optional[float] = None) -> list[Ack]:
         """Blocks until every batch sent so far is answered; returns the Acks that came since the
         last wait() (in sequence order). Raises the stream's fremen.Error if it failed, and
         DeadlineExceeded after `timeout` seconds."""
@@ -340,7 +353,7 @@ class IngestSession:
             acks, self._new_acks = self._new_acks, []
             return acks
 
-    def close(self, timeout=None):
+    def close(self, timeout: Optional[float] = None) -> list[Ack]:
         """Ends the stream after the batches sent, waits for their answers and the daemon's end of
         the call; returns the Acks not yet returned by wait(). Raises the stream's fremen.Error."""
         with self._lock:
@@ -351,10 +364,10 @@ class IngestSession:
         if self._reader.is_alive():
             self.cancel()
             raise errors.error_for(grpc.StatusCode.DEADLINE_EXCEEDED,
-                                  f"the ingest stream did not end within {timeout} s")
+                                   f"the ingest stream did not end within {timeout} s")
         return self.wait()
 
-    def cancel(self):
+    def cancel(self) -> None:
         """Abandons the stream: batches not yet answered may or may not have been applied (resend
         them with the same writer id and sequence numbers to find out)."""
         with self._lock:
@@ -365,10 +378,11 @@ class IngestSession:
         requests.put(_END)
         self._reader.join()
 
-    def __enter__(self):
+    def __enter__(self) -> "IngestSession":
         return self
 
-    def __exit__(self, exc_type, exc, traceback):
+    def __exit__(self, exc_type: Optional[type[BaseException]], exc: Optional[BaseException],
+                 traceback: Optional[TracebackType]) -> Literal[False]:
         if exc_type is None:
             self.close()
         else:

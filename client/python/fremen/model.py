@@ -7,6 +7,9 @@ Predict evaluates (without persistence).
 
 import dataclasses
 import math
+from typing import Iterable, Optional
+
+from fremen.v1 import query_pb2
 
 
 @dataclasses.dataclass(frozen=True)
@@ -16,7 +19,7 @@ class Component:
     amplitude: float
     phase: float  # radians
 
-    def value(self, t):
+    def value(self, t: float) -> float:
         return self.amplitude * math.cos(2 * math.pi * t / self.period_seconds + self.phase)
 
 
@@ -39,7 +42,7 @@ class StateModel:
     """What the daemon knows of one state. `proto` is the fremen.v1.StateModel it came from (with
     the lossless history's details for lossless maps)."""
     id: int
-    cell: tuple  # (x, y, z) in grid maps, None in generic ones
+    cell: Optional[tuple[int, int, int]]  # (x, y, z) in grid maps, None in generic ones
     name: str
     group: str
     never_changed: bool
@@ -47,23 +50,23 @@ class StateModel:
     first_time: float
     last_time: float
     mean: float
-    spectrum: list  # Components of every modelled period, when asked for
+    spectrum: list[Component]  # every modelled period, when asked for
     published_mean: float
     selected_order: int
-    published: list  # Components of P, strongest first
-    order_errors: list
+    published: list[Component]  # P's, strongest first
+    order_errors: list[OrderError]
     persistence: Persistence
-    proto: object = dataclasses.field(repr=False, compare=False)
+    proto: query_pb2.StateModel = dataclasses.field(repr=False, compare=False)
 
-    def probability(self, t, order=None):
+    def probability(self, t: float, order: Optional[int] = None) -> float:
         """p(t) of the published model at `order` (default: the selected one)."""
         order = self.selected_order if order is None else order
         p = self.published_mean + sum(c.value(t) for c in self.published[:order])
         return min(1.0, max(0.0, p))
 
     @classmethod
-    def from_proto(cls, model):
-        def components(items):
+    def from_proto(cls, model: query_pb2.StateModel) -> "StateModel":
+        def components(items: Iterable[query_pb2.Component]) -> list[Component]:
             return [Component(c.period_seconds, c.amplitude, c.phase) for c in items]
         return cls(
             id=model.id,

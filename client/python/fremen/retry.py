@@ -12,8 +12,11 @@ Thread-safety: a Backoff is immutable; each pauses() iterator belongs to one thr
 import dataclasses
 import random
 import time
+from typing import Any, Callable, Iterator, Optional, TypeVar
 
 from fremen import errors
+
+Result = TypeVar("Result")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -29,7 +32,7 @@ class Backoff:
     max_attempts: int = 10
     max_elapsed: float = 30.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         checks = [
             ("initial", self.initial > 0, "> 0"),
             ("multiplier", self.multiplier >= 1, ">= 1"),
@@ -42,13 +45,14 @@ class Backoff:
             if not ok:
                 raise errors.InvalidArgument(f"Backoff.{field} must be {requirement}, got {getattr(self, field)!r}")
 
-    def delay(self, retry, draw=random.random):
+    def delay(self, retry: int, draw: Callable[[], float] = random.random) -> float:
         """The pause before retry number `retry` (1 = the first retry); `draw` gives a number in
         [0, 1) that picks how much jitter shortens it."""
         base = min(self.maximum, self.initial * self.multiplier ** (retry - 1))
         return base * (1 - self.jitter * draw())
 
-    def pauses(self, clock=time.monotonic, draw=random.random):
+    def pauses(self, clock: Callable[[], float] = time.monotonic,
+               draw: Callable[[], float] = random.random) -> Iterator[float]:
         """The pauses before each retry, from the first failure on, until a bound is reached."""
         start = clock()
         for retry in range(1, self.max_attempts):
@@ -57,7 +61,7 @@ class Backoff:
                 return
             yield pause
 
-    def channel_options(self):
+    def channel_options(self) -> list[tuple[str, Any]]:
         """gRPC channel options that make the channel's own reconnection attempts (after a lost
         connection it tries again only after its own backoff, 1 s growing to 120 s by default)
         follow the same pace, so that a retry finds the daemon soon after it is back."""
@@ -65,7 +69,8 @@ class Backoff:
                 ("grpc.max_reconnect_backoff_ms", max(1, int(self.maximum * 1000)))]
 
 
-def retrying(backoff, attempt, sleep=time.sleep):
+def retrying(backoff: Optional[Backoff], attempt: Callable[[], Result],
+             sleep: Callable[[float], None] = time.sleep) -> Result:
     """attempt() again, after backoff's pauses, while it raises fremen.Unavailable; its result, or
     the last Unavailable once the bound is reached. backoff None: one try."""
     if backoff is None:

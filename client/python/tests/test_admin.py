@@ -8,7 +8,6 @@ import unittest
 import grpc
 
 import fremen
-from fremen.v1 import admin_pb2, maps_pb2
 from fremend_process import DaemonTestCase
 
 T = 1.7e9
@@ -37,12 +36,14 @@ class AdminTest(DaemonTestCase):
     def test_backup_then_restore_under_a_new_name(self):
         observations = self.fill("lab")
         backup = self.client.backup_map("lab", "nightly/lab")
+        self.assertIsInstance(backup, fremen.Backup)
         self.assertTrue(backup.path.endswith(os.path.join("nightly", "lab")), backup.path)
         self.assertTrue(os.path.exists(os.path.join(backup.path, "map.info")))
         self.assertGreater(backup.bytes, 0)
         restored = self.client.restore_map("nightly/lab", "lab-copy")
         self.assertEqual(restored.name, "lab-copy")
-        self.assertEqual(restored.kind, maps_pb2.MAP_KIND_GENERIC)
+        self.assertIsInstance(restored, fremen.MapInfo)
+        self.assertEqual(restored.kind, "generic")
         self.assertEqual([m.name for m in self.client.list_maps()], ["lab", "lab-copy"])
         self.assertEqual(self.client.stats("lab-copy").observations, observations)
         self.assertEqual(self.client.model("lab-copy", name="a").observations, 20)
@@ -71,13 +72,17 @@ class AdminTest(DaemonTestCase):
     def test_operations_listed_newest_first_on_every_page(self):
         self.client.create_map("a")
         self.client.create_map("b")
-        names = [self.client.update(m).name for m in ("a", "b", "a")]
+        operations = [self.client.update(m) for m in ("a", "b", "a")]
+        self.assertIsInstance(operations[0], fremen.Operation)
+        names = [op.name for op in operations]
         self.assertEqual([op.name for op in self.client.list_operations()], names[::-1])
         self.assertEqual([op.name for op in self.client.list_operations("a", page_size=1)], [names[2], names[0]])
         self.assertEqual(list(self.client.list_operations(running_only=True)), [])
         again = self.client.get_operation(names[1])
-        self.assertEqual((again.name, again.map, again.done, again.trigger), (names[1], "b", True, "RunUpdate"))
-        self.assertEqual(again.stage, admin_pb2.OPERATION_STAGE_DONE)
+        self.assertEqual((again.name, again.map_name, again.done, again.trigger), (names[1], "b", True, "RunUpdate"))
+        self.assertEqual(again.stage, "done")
+        self.assertIsNone(again.error)
+        self.assertGreaterEqual(again.end_time, again.create_time)
         self.assertEqual(self.client.get_operation(names[1], "b").name, names[1])
 
     def test_operation_errors(self):
@@ -101,20 +106,21 @@ class AdminTest(DaemonTestCase):
         self.client.create_map("small")
         big = self.client.update("big", wait=False)
         small = self.client.update("small", wait=False)  # updates run one at a time: behind big
-        self.assertEqual(small.stage, admin_pb2.OPERATION_STAGE_QUEUED)
+        self.assertEqual(small.stage, "queued")
         self.assertEqual([op.name for op in self.client.list_operations(running_only=True)], [small.name, big.name])
         cancelled = self.client.cancel_operation(small.name)
         self.assertTrue(cancelled.done)
         self.assertTrue(cancelled.cancel_requested)
-        self.assertEqual(cancelled.error.code, grpc.StatusCode.CANCELLED.value[0])
-        self.assertFalse(cancelled.HasField("update"))
-        self.assertEqual(self.client.get_operation(small.name).error.code, grpc.StatusCode.CANCELLED.value[0])
+        self.assertEqual(cancelled.error.code, grpc.StatusCode.CANCELLED)
+        self.assertIsInstance(cancelled.error, fremen.Error)
+        self.assertIsNone(cancelled.update)
+        self.assertEqual(self.client.get_operation(small.name).error.code, grpc.StatusCode.CANCELLED)
 
         finished = self.client.update("big")  # RunUpdate answers the running job: waits for it
         self.assertEqual(finished.name, big.name)
         self.assertEqual(finished.update.states_published, BIG_NX * BIG_NY)
         unchanged = self.client.cancel_operation(big.name)
-        self.assertEqual(unchanged.error.code, 0)
+        self.assertIsNone(unchanged.error)
         self.assertFalse(unchanged.cancel_requested)
 
     # --- status ---
@@ -123,18 +129,23 @@ class AdminTest(DaemonTestCase):
         self.fill("lab")
         done = self.client.update("lab")
         status = self.client.server_status()
-        self.assertTrue(status.version)
+        self.assertIsInstance(status, fremen.ServerStatus)
+        self.assertEqual(status.version, fremen.__version__)
         self.assertEqual(status.map_count, 1)
         self.assertEqual(status.state_count, 3)
         self.assertEqual(status.dynamic_state_count, 1)
         self.assertEqual(status.running_operations, 0)
-        self.assertEqual(status.store_state, admin_pb2.STORE_STATE_OPEN)
+        self.assertEqual(status.store_state, "open")
         self.assertFalse(status.tls)
         self.assertFalse(status.tokens_required)
         self.assertGreater(status.uptime_seconds, 0)
         self.assertGreater(status.data_dir_free_bytes, 0)
-        self.assertEqual([op.name for op in status.last_updates], [done.name])
-        self.assertEqual(list(status.failed_maps), [])
+        self.assertEqual({m: op.name for m, op in status.last_updates.items()}, {"lab": done.name})
+        self.assertEqual(list(status.map_updates), ["lab"])
+        self.assertEqual(status.map_updates["lab"].states_updated, 1)
+        self.assertEqual(status.failed_maps, {})
+        self.assertIsNone(status.next_scrub_time)  # scrubbing is off by default
+        self.assertGreater(status.start_time, 1.7e9)
 
 
 class AdminTokensTest(DaemonTestCase):

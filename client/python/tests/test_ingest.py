@@ -36,8 +36,8 @@ class IngestTest(DaemonTestCase):
             session.send(T, [1, 1.5, math.nan, 0], names=["a", "b", "c", "d"])
             (ack,) = session.wait()
         self.assertEqual((ack.accepted, ack.rejected), (2, 2))
-        self.assertEqual(ack.rejections, [fremen.Rejection(1, "VALUE_OUT_OF_RANGE"),
-                                          fremen.Rejection(2, "VALUE_OUT_OF_RANGE")])
+        self.assertEqual(ack.rejections, [fremen.Rejection(1, "value_out_of_range"),
+                                          fremen.Rejection(2, "value_out_of_range")])
 
     def test_grid_cells_by_index_and_by_point_outside_cells_rejected(self):
         self.client.create_map("lab", size=(8, 6, 2), resolution=0.5)
@@ -46,8 +46,8 @@ class IngestTest(DaemonTestCase):
         session.send(T, [1, 1, 1], points=[(0.1, 0.1), (3.9, 2.9, 0.9), (-0.1, 0)])
         acks = session.close()  # close() answers what wait() has not
         self.assertEqual([(a.accepted, a.rejected) for a in acks], [(2, 1), (2, 1)])
-        self.assertEqual(acks[0].rejections, [fremen.Rejection(2, "OUTSIDE_MAP")])
-        self.assertEqual(acks[1].rejections, [fremen.Rejection(2, "OUTSIDE_MAP")])
+        self.assertEqual(acks[0].rejections, [fremen.Rejection(2, "outside_map")])
+        self.assertEqual(acks[1].rejections, [fremen.Rejection(2, "outside_map")])
 
     def test_patches_of_floats_and_of_bytes_are_acknowledged(self):
         self.client.create_map("lab", size=(8, 6), resolution=0.5)
@@ -117,6 +117,7 @@ class IngestTest(DaemonTestCase):
 
     def test_a_message_the_daemon_cannot_parse_ends_the_session_naming_its_position(self):
         self.client.create_map("doors")
+
         # A link that damages the second message on its way: its bytes cut short.
         def damaging(request):
             data = request.SerializeToString()

@@ -1,50 +1,54 @@
-"""Client.create_map / get_map / list_maps / delete_map against a real fremend, and their errors
-raised as fremen.Error subclasses carrying the gRPC code and the daemon's message."""
+"""Client.create_map / get_map / list_maps / delete_map against a real fremend (a fremen.MapInfo
+whose fields are named as create_map's parameters), and their errors raised as fremen.Error
+subclasses carrying the gRPC code and the daemon's message."""
 
 import unittest
 
 import grpc
 
 import fremen
-from fremen.v1 import maps_pb2
 from fremend_process import DaemonTestCase
 
 
 class MapsTest(DaemonTestCase):
     def test_create_grid_2d_fills_in_the_defaults(self):
         made = self.client.create_map("lab", size=(40, 30), resolution=0.5, origin=(-1, 2))
+        self.assertIsInstance(made, fremen.MapInfo)
         self.assertEqual(made.name, "lab")
-        self.assertEqual(made.kind, maps_pb2.MAP_KIND_GRID)
-        self.assertEqual((made.grid.size.x, made.grid.size.y, made.grid.size.z), (40, 30, 1))
-        self.assertEqual(made.grid.resolution, 0.5)
-        self.assertEqual((made.grid.origin.x, made.grid.origin.y), (-1, 2))
-        self.assertEqual(made.periods.longest_seconds, 604800)
-        self.assertEqual(made.periods.count, 24)
+        self.assertEqual(made.kind, "grid")
+        self.assertEqual(made.size, (40, 30, 1))
+        self.assertEqual(made.resolution, 0.5)
+        self.assertEqual(made.origin, (-1, 2, 0))
+        self.assertEqual(made.longest_period, 604800)
+        self.assertEqual(made.period_count, 24)
+        self.assertEqual(made.periods, [])
         self.assertEqual(made.max_order, 5)
         self.assertTrue(made.persistence)
-        self.assertGreater(made.create_time.seconds, 0)
+        self.assertEqual(made.criterion, "threshold")
+        self.assertGreater(made.create_time, 1.7e9)
+        self.assertEqual(made.proto.grid.size.x, 40)  # the message it came from
 
     def test_create_grid_3d_and_generic_keep_every_setting(self):
         grid = self.client.create_map("cube", size=(10, 20, 4), resolution=0.25, longest_period=86400,
                                       period_count=6, floor_periods=True, max_order=3, persistence=False,
                                       error_half_life=3600, criterion="squared", lossless_sampling=60,
                                       lossless_origin=1.7e9, shards=3)
-        self.assertEqual((grid.grid.size.x, grid.grid.size.y, grid.grid.size.z), (10, 20, 4))
-        self.assertEqual(grid.periods.longest_seconds, 86400)
-        self.assertEqual(grid.periods.count, 6)
-        self.assertTrue(grid.periods.floor_periods)
+        self.assertEqual(grid.size, (10, 20, 4))
+        self.assertEqual(grid.longest_period, 86400)
+        self.assertEqual(grid.period_count, 6)
+        self.assertTrue(grid.floor_periods)
         self.assertEqual(grid.max_order, 3)
         self.assertFalse(grid.persistence)
-        self.assertEqual(grid.error_half_life_seconds, 3600)
-        self.assertEqual(grid.criterion, maps_pb2.ERROR_CRITERION_SQUARED)
-        self.assertEqual(grid.lossless_sampling_seconds, 60)
+        self.assertEqual(grid.error_half_life, 3600)
+        self.assertEqual(grid.criterion, "squared")
+        self.assertEqual(grid.lossless_sampling, 60)
         self.assertEqual(grid.lossless_origin, 1.7e9)
         self.assertEqual(grid.shards, 3)
 
         doors = self.client.create_map("doors", periods=[86400, 43200, 3600])
-        self.assertEqual(doors.kind, maps_pb2.MAP_KIND_GENERIC)
-        self.assertFalse(doors.HasField("grid"))
-        self.assertEqual(list(doors.periods.explicit_seconds), [86400, 43200, 3600])
+        self.assertEqual(doors.kind, "generic")
+        self.assertEqual((doors.size, doors.resolution, doors.origin), (None, None, None))
+        self.assertEqual(doors.periods, [86400, 43200, 3600])
 
     def test_get_map_answers_what_create_map_made(self):
         made = self.client.create_map("lab", size=(8, 8), resolution=0.1)

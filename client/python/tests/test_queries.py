@@ -192,15 +192,14 @@ class QueriesTest(DaemonTestCase):
                 daemon = float(self.client.predict("doors", t, names=["door"], order=order).probabilities[0, 0])
                 self.assertAlmostEqual(door.probability(t, order), daemon, places=4, msg=f"order {order} at {t}")
 
-    def test_model_of_a_cell_raw_and_never_observed(self):
+    def test_model_of_a_cell_its_message_and_never_observed(self):
         self.fill_grid()
         cell = self.client.model("lab", cell=(3, 2))
         self.assertEqual(cell.cell, (3, 2, 0))
         self.assertEqual(cell.observations, DAYS * 24)
         by_point = self.client.model("lab", point=(3 * 0.25 + 0.1, 2 * 0.25 + 0.1))
         self.assertEqual(by_point.id, cell.id)
-        raw = self.client.model("lab", cell=(3, 2), raw=True)
-        self.assertEqual(raw.observations, DAYS * 24)
+        self.assertEqual(cell.proto.observations, DAYS * 24)
         self.assertIsNone(self.client.model("lab", cell=(3, NY - 1)))
 
     def test_model_errors(self):
@@ -218,6 +217,8 @@ class QueriesTest(DaemonTestCase):
     def test_stats_count_states_and_observations(self):
         self.fill_doors()
         stats = self.client.stats("doors")
+        self.assertIsInstance(stats, fremen.MapStats)
+        self.assertIsInstance(stats.last_update, fremen.MapUpdate)  # fill_doors updates after each week
         self.assertEqual(stats.states, 2)
         self.assertEqual(stats.dynamic_states, 1)
         self.assertEqual(stats.observations, 2 * DAYS * 24)
@@ -248,7 +249,8 @@ class QueriesTest(DaemonTestCase):
         self.client.create_map("doors")
         operation = self.client.update("doors")
         self.assertTrue(operation.done)
-        self.assertEqual(operation.map, "doors")
+        self.assertEqual(operation.map_name, "doors")
+        self.assertEqual(operation.stage, "done")
         started = self.client.update("doors", wait=False)
         self.assertTrue(started.name.startswith("operations/"))
         with self.assertRaises(fremen.NotFound):

@@ -144,7 +144,6 @@ class ReconnectTest(DaemonTestCase):
         self.restart_daemon()
 
 
-
 class StuckCall:
     """Fault injection: an Ingest call that ended with UNAVAILABLE while its response iterator waits
     for ever, as python3-grpcio 1.51's sometimes does for a call that fails at once."""
