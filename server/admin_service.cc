@@ -284,8 +284,10 @@ absl::Status AdminServiceImpl::Restore(const v1::RestoreMapRequest& request, con
   }
   auto store = deps_.store->Get();
   if (!store.ok()) return store.status();
-  auto info = (*store)->RestoreMap(*dir, *name);
-  if (absl::IsDataLoss(info.status())) DaemonLog()->warn("restore refused: {}", std::string(info.status().message()));
+  auto info = (*store)->RestoreMap(*dir, *name, CallDeadline(context));
+  if (absl::IsDataLoss(info.status()) || absl::IsDeadlineExceeded(info.status())) {
+    DaemonLog()->warn("restore refused: {}", std::string(info.status().message()));
+  }
   if (!info.ok()) return RenameNameField(info.status(), "map");
   MapInfoToProto(*info, *response.mutable_map());
   DaemonLog()->info("map {} restored from {}", info->name, *dir);
@@ -303,7 +305,11 @@ grpc::ServerUnaryReactor* AdminServiceImpl::CheckMap(grpc::CallbackServerContext
     auto map = (*store)->Map(*name);
     if (!map.ok()) return map.status();
     const absl::Time start = admin_.clock->Now();
-    const storage::VerifyReport report = (*map)->Verify();
+    const storage::VerifyReport report = (*map)->Verify(CallDeadline(*context));
+    if (report.deadline_exceeded) {
+      return absl::DeadlineExceededError(absl::StrCat("map ", *name, ": the check did not finish by the call's deadline (",
+                                                      storage::FormatProblem(report.problems.back()), ")"));
+    }
     VerifyReportToProto(report, *response);
     response->set_duration_seconds(absl::ToDoubleSeconds(admin_.clock->Now() - start));
     if (report.clean()) {
@@ -325,7 +331,7 @@ grpc::ServerUnaryReactor* AdminServiceImpl::SalvageMap(grpc::CallbackServerConte
     auto store = deps_.store->Get();
     if (!store.ok()) return store.status();
     const absl::Time start = admin_.clock->Now();
-    auto report = (*store)->SalvageMap(*name, request->new_map());
+    auto report = (*store)->SalvageMap(*name, request->new_map(), CallDeadline(*context));
     if (!report.ok()) {
       DaemonLog()->warn("salvage of map {} failed: {}", *name, std::string(report.status().message()));
       return RenameNameField(report.status(), "new_map");

@@ -16,11 +16,13 @@
 #include <grpcpp/server_context.h>
 #include <grpcpp/support/server_callback.h>
 
+#include <chrono>
 #include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "absl/time/time.h"
 #include "server/access_log.h"
 #include "server/auth.h"
 #include "server/blocking_pool.h"
@@ -29,6 +31,14 @@
 #include "server/store_handle.h"
 
 namespace fremen::server {
+
+// The call's deadline, for work that must not outlive it (a forked verifier, storage/isolated_child.h);
+// InfiniteFuture when the client set none.
+inline absl::Time CallDeadline(const grpc::ServerContextBase& context) {
+  const std::chrono::system_clock::time_point deadline = context.deadline();
+  if (deadline == std::chrono::system_clock::time_point::max()) return absl::InfiniteFuture();
+  return absl::FromChrono(deadline);
+}
 
 // What the services need from the daemon. Owned by the daemon; outlives the gRPC server.
 struct ServiceDeps {

@@ -703,11 +703,12 @@ absl::StatusOr<uint64_t> MapStore::Backup(const std::string& dir) {
   return bytes;
 }
 
-VerifyReport MapStore::Verify() {
+VerifyReport MapStore::Verify(absl::Time deadline) {
   std::lock_guard backup(backup_mutex_);
   VerifyOptions options;
   options.isolate = true;
   options.live = true;
+  options.deadline = deadline;
   return VerifyMap(dir_, info_, options);
 }
 

@@ -162,7 +162,8 @@ class MapStore {
   // and an abort on a damaged page ends the child, not the daemon. Checkpoints wait meanwhile (as
   // for a backup), so that the shards and the log are read at one position and no log segment is
   // dropped while it is read; batches go on being logged and acknowledged.
-  VerifyReport Verify();
+  // A shard not read by `deadline` is reported "not verified".
+  VerifyReport Verify(absl::Time deadline = absl::InfiniteFuture());
 
  private:
   // A submitted batch. Everything that needs no shared state — classification, the log record,

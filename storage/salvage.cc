@@ -125,8 +125,9 @@ bool SendDatabase(int fd, const std::string& shard_dir, const std::string& db_na
 // A damaged map's records, one database at a time, into the new shard.
 class ShardSalvager {
  public:
-  ShardSalvager(const MapInfo& info, const model::ModelSettings& settings, uint32_t shard, SalvageReport& report)
-      : shard_(shard), checks_(info, settings, shard), report_(report) {
+  ShardSalvager(const MapInfo& info, const model::ModelSettings& settings, uint32_t shard, absl::Time deadline,
+                SalvageReport& report)
+      : shard_(shard), deadline_(deadline), checks_(info, settings, shard), report_(report) {
     shard_report_.shard = shard;
   }
 
@@ -257,7 +258,15 @@ class ShardSalvager {
                                 pos += 4 + n;
                               }
                               buffer.erase(0, pos);
-                            });
+                            },
+                            deadline_);
+    if (absl::IsDeadlineExceeded(exit.status())) {
+      // Not a loss of the damaged map: the salvage is not finished, and no map is made of half of it.
+      write_error_ = absl::DeadlineExceededError(
+          absl::StrCat("the salvage did not finish by its deadline, at ", ShardFile(shard_), " ", db, ": ",
+                       exit.status().message()));
+      return;
+    }
     Flush();
     // The LSN's record was not among those read before the meta database stopped, or (below) a damaged record whose
     // key may have been it: what the shard holds of the log is unknown.
@@ -394,6 +403,7 @@ class ShardSalvager {
   };
 
   const uint32_t shard_;
+  const absl::Time deadline_;
   const ShardRecordChecks checks_;
   SalvageReport& report_;
   SalvageShard shard_report_;
@@ -487,7 +497,7 @@ absl::Status SalvageLogRecords(const std::string& from_wal, const std::string& t
 }  // namespace
 
 absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const std::string& to_dir, const MapInfo& info,
-                                           const StoreOptions& options) {
+                                           const StoreOptions& options, absl::Time deadline) {
   auto settings = ModelSettingsOf(info);
   if (!settings.ok()) return settings.status();
   SalvageReport report;
@@ -496,7 +506,7 @@ absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const st
   (void)sr::AllDatabases();  // initialised before any fork
   std::vector<std::unique_ptr<ShardSalvager>> shards;
   for (uint32_t i = 0; i < info.shards; ++i) {
-    shards.push_back(std::make_unique<ShardSalvager>(info, *settings, i, report));
+    shards.push_back(std::make_unique<ShardSalvager>(info, *settings, i, deadline, report));
     if (absl::Status s = shards.back()->Run(from_dir, absl::StrCat(to_dir, "/shard-", i)); !s.ok()) {
       return absl::Status(s.code(), absl::StrCat(to_dir, "/shard-", i, ": ", s.message()));
     }
@@ -553,7 +563,8 @@ absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const st
 
 namespace fremen::storage {
 
-absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const std::string& new_name) {
+absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const std::string& new_name,
+                                                absl::Time deadline) {
   const std::string target_name = new_name.empty() ? name + "-salvaged" : new_name;
   std::unique_lock lock(mutex_);
   const auto failed = failed_.find(name);
@@ -596,7 +607,7 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
   if (error) {
     report = absl::InternalError(absl::StrCat(target, ": ", error.message()));
   } else {
-    report = SalvageFiles(from_dir, target, *created, options_);
+    report = SalvageFiles(from_dir, target, *created, options_, deadline);
   }
   lock.lock();
   salvaging_.erase(name);

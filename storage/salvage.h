@@ -75,8 +75,9 @@ struct SalvageReport {
 
 // Writes into `to_dir` (shard-N/, wal/; created) everything of the map in `from_dir` that verifies,
 // as `info` describes the map. Errors only for what prevents the salvage itself (the new files
-// cannot be written, the map's settings are invalid); damage is the report's.
+// cannot be written, the map's settings are invalid) or end it (DeadlineExceeded: `deadline` came
+// before every record was read); damage is the report's.
 absl::StatusOr<SalvageReport> SalvageFiles(const std::string& from_dir, const std::string& to_dir, const MapInfo& info,
-                                           const StoreOptions& options);
+                                           const StoreOptions& options, absl::Time deadline = absl::InfiniteFuture());
 
 }  // namespace fremen::storage

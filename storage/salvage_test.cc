@@ -520,5 +520,24 @@ TEST(SalvageTest, ASalvageThatCannotWriteLeavesNothingBehind) {
   EXPECT_TRUE((*store)->Map("m-salvaged").ok());
 }
 
+TEST(SalvageTest, ASalvagePastItsDeadlineMakesNoMap) {
+  TempDir dir, image;
+  const uint64_t id = CrashedAfterCheckpoint(dir, image, 1, 20, 8).id;
+  DamageLogRecord(OnlySegment(MapDir(image, id) + "/wal"), 35);
+  auto store = Store::Open(image.path(), {});
+  ASSERT_TRUE(store.ok());
+  ASSERT_EQ((*store)->FailedMaps().size(), 1u);
+  auto late = (*store)->SalvageMap("m", "", absl::InfinitePast());
+  ASSERT_TRUE(absl::IsDeadlineExceeded(late.status())) << late.status();
+  EXPECT_NE(late.status().message().find("the salvage did not finish by its deadline, at shard-0/data.mdb"),
+            std::string::npos)
+      << late.status();
+  EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("m-salvaged").status()));
+  std::vector<std::string> dirs;
+  for (const auto& e : std::filesystem::directory_iterator(image.path() + "/maps")) dirs.push_back(e.path().string());
+  EXPECT_EQ(dirs, std::vector<std::string>{MapDir(image, id)});
+  EXPECT_TRUE((*store)->SalvageMap("m", "").ok());
+}
+
 }  // namespace
 }  // namespace fremen::storage

@@ -179,7 +179,7 @@ absl::StatusOr<uint64_t> Store::BackupMap(const std::string& name, const std::st
   return (*map)->Backup(dir);
 }
 
-absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::string& name) {
+absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::string& name, absl::Time deadline) {
   std::ifstream in(dir + "/map.info", std::ios::binary);
   if (!in) return absl::NotFoundError(absl::StrCat(dir, " holds no backup (no map.info)"));
   std::stringstream bytes;
@@ -191,7 +191,13 @@ absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::str
   // may abort on a damaged page without taking the daemon down.
   VerifyOptions verify;
   verify.isolate = true;
-  if (const VerifyReport report = VerifyShards(dir, info, verify); !report.clean()) {
+  verify.deadline = deadline;
+  const VerifyReport report = VerifyShards(dir, info, verify);
+  if (report.deadline_exceeded) {
+    return absl::DeadlineExceededError(absl::StrCat("backup ", dir, " was not restored: its check did not finish by the "
+                                                    "call's deadline (", FormatProblem(report.problems.back()), ")"));
+  }
+  if (!report.clean()) {
     return absl::DataLossError(absl::StrCat("backup ", dir, " is damaged: ", FormatProblem(report.problems[0]),
                                             report.problems.size() > 1
                                                 ? absl::StrCat(" (and ", report.problems.size() - 1, " more problems)")

@@ -59,7 +59,9 @@ class Store {
   absl::StatusOr<uint64_t> BackupMap(const std::string& name, const std::string& dir);
   // A backup made by BackupMap as a new map named `name` (empty: the backed-up map's name). The copy is probed and
   // loaded (every record checked) before the map is listed.
-  absl::StatusOr<MapInfo> RestoreMap(const std::string& dir, const std::string& name);
+  // A shard whose check has not finished by `deadline` makes it DeadlineExceeded, nothing created.
+  absl::StatusOr<MapInfo> RestoreMap(const std::string& dir, const std::string& name,
+                                     absl::Time deadline = absl::InfiniteFuture());
 
   // A new map `new_name` (empty: name + "-salvaged") holding everything of the failed map `name` that verifies, served
   // once it opens like any other (storage/salvage.h); the failed map and its files are left as they are. NotFound for
@@ -67,7 +69,9 @@ class Store {
   // AlreadyExists when new_name is taken. When the copy does not open, only the directory this call made is removed.
   // The files are read and written without holding the store's lock (the other maps serve meanwhile); until the call
   // returns, both maps refuse DeleteMap and Map(new_name) answers Unavailable.
-  absl::StatusOr<SalvageReport> SalvageMap(const std::string& name, const std::string& new_name);
+  // Not finished by `deadline`: DeadlineExceeded, and the new map's directory is removed.
+  absl::StatusOr<SalvageReport> SalvageMap(const std::string& name, const std::string& new_name,
+                                           absl::Time deadline = absl::InfiniteFuture());
 
   // Maps that did not open at Open, in name order.
   std::vector<FailedMap> FailedMaps() const;

@@ -57,6 +57,7 @@ struct ShardResult {
   ShardVerifyReport report;
   std::vector<VerifyProblem> problems;
   std::vector<std::string> notes;
+  bool deadline_exceeded = false;
 };
 
 // Checks every record of one open shard environment.
@@ -290,15 +291,16 @@ absl::StatusOr<ShardResult> DecodeResult(std::string_view bytes, uint32_t shard)
 
 // CheckShard in a forked child (storage/isolated_child.h), which sends its result over a pipe.
 ShardResult CheckShardIsolated(const std::string& dir, const MapInfo& info, const model::ModelSettings& settings,
-                               uint32_t shard, bool live) {
+                               uint32_t shard, bool live, absl::Time deadline) {
   ShardResult failed;
   failed.report.shard = shard;
   std::string bytes;
   auto exit = RunIsolated(
       [&](int fd) { return WriteAll(fd, EncodeResult(CheckShard(dir, info, settings, shard, live))); },
-      [&](std::string_view chunk) { bytes.append(chunk); });
+      [&](std::string_view chunk) { bytes.append(chunk); }, deadline);
   if (!exit.ok()) {
     failed.problems.push_back({ShardFile(shard), "", absl::StrCat("not verified: ", exit.status().message())});
+    failed.deadline_exceeded = absl::IsDeadlineExceeded(exit.status());
     return failed;
   }
   if (exit->signal != 0) {
@@ -489,11 +491,15 @@ VerifyReport Verify(const std::string& dir, const MapInfo& info, const VerifyOpt
   }
   (void)sr::AllDatabases();  // initialised before any fork
   for (uint32_t i = 0; i < info.shards; ++i) {
-    ShardResult result = options.isolate ? CheckShardIsolated(dir, info, *settings, i, options.live)
+    ShardResult result = options.isolate ? CheckShardIsolated(dir, info, *settings, i, options.live, options.deadline)
                                          : CheckShard(dir, info, *settings, i, options.live);
     report.shards.push_back(result.report);
     for (VerifyProblem& p : result.problems) report.problems.push_back(std::move(p));
     for (std::string& n : result.notes) report.notes.push_back(std::move(n));
+    if (result.deadline_exceeded) {
+      report.deadline_exceeded = true;
+      return report;
+    }
   }
   if (with_log) VerifyLog(dir, options.live, report);
   return report;

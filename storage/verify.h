@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/time/time.h"
 #include "storage/map_info.h"
 
 namespace fremen::storage {
@@ -45,6 +46,9 @@ struct VerifyOptions {
   // log segment may be a record being written. Otherwise the files must be at rest and no lock
   // file is used or created (a backup directory is left exactly as it is). Default: false.
   bool live = false;
+  // With isolate: a shard whose child has not finished by then is reported "not verified" (the
+  // child is killed), so that a call's deadline bounds the check. Default: none.
+  absl::Time deadline = absl::InfiniteFuture();
 };
 
 // One thing found wrong.
@@ -82,6 +86,9 @@ struct VerifyReport {
   std::vector<VerifyProblem> problems;
   // Worth knowing, not wrong (a torn tail, an unknown meta record).
   std::vector<std::string> notes;
+  // VerifyOptions::deadline came first: the shards after the one it stopped are not in `shards`,
+  // the log was not read, and `problems` says which shard was not verified.
+  bool deadline_exceeded = false;
 
   bool clean() const { return problems.empty(); }
 };

@@ -289,6 +289,37 @@ TEST(VerifyTest, ARestoreOfADamagedBackupIsRefusedAndCreatesNothing) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator()), maps_before);
 }
 
+TEST(VerifyTest, ARestoreOrCheckPastItsDeadlineIsDeadlineExceededAndCreatesNothing) {
+  TempDir dir, backup;
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto info = (*store)->CreateMap(GridMap("source", 64, 64, 1, 2));
+  ASSERT_TRUE(info.ok()) << info.status();
+  auto map = (*store)->Map("source");
+  ASSERT_TRUE(map.ok());
+  for (uint64_t i = 0; i < 10; ++i) ASSERT_TRUE((*map)->Write(SweepScan(*info, 1, i, 800)).ok());
+  const std::string copy = backup.path() + "/copy";
+  ASSERT_TRUE((*store)->BackupMap("source", copy).ok());
+
+  // A deadline that has passed: no shard is read, and the check says so rather than "damaged".
+  const VerifyReport late = (*map)->Verify(absl::InfinitePast());
+  EXPECT_TRUE(late.deadline_exceeded);
+  ASSERT_EQ(late.problems.size(), 1u) << Describe(late);
+  EXPECT_EQ(late.problems[0].file, "shard-0/data.mdb");
+  EXPECT_TRUE(absl::StrContains(late.problems[0].what, "not verified: the deadline had passed")) << Describe(late);
+  EXPECT_EQ(late.shards.size(), 1u);  // the shards after it are not tried
+  EXPECT_FALSE((*map)->Verify().deadline_exceeded);
+
+  const auto maps_before = std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator());
+  const auto restored = (*store)->RestoreMap(copy, "late", absl::InfinitePast());
+  ASSERT_TRUE(absl::IsDeadlineExceeded(restored.status())) << restored.status();
+  EXPECT_TRUE(absl::StrContains(restored.status().message(), "was not restored: its check did not finish"))
+      << restored.status();
+  EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("late").status()));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator()), maps_before);
+  EXPECT_TRUE((*store)->RestoreMap(copy, "in-time").ok());
+}
+
 TEST(VerifyTest, AnOpenMapVerifiesCleanWhileBatchesAndCheckpointsGoOn) {
   TempDir dir;
   const MapInfo info = GridMap("busy", 64, 64, 1, 2);

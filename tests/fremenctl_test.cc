@@ -1,19 +1,15 @@
 // End-to-end tests of fremenctl's daemon commands (maps, predict, top, anomalies, stats, update,
-// backup, restore, status, the global connection options): the real binary (FREMENCTL_BINARY) run
+// operations, backup, restore, status, the global connection options): the real binary (FREMENCTL_BINARY) run
 // against a real fremend, each command's output and exit code checked, and a bad-input case each
 // with the message that says what to fix. Data is put in through the C++ client library.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <future>
-#include <iterator>
 #include <sstream>
 #include <string>
 
 #include "absl/strings/str_cat.h"
-#include "absl/time/clock.h"
 #include "client/lib/client.h"
 #include "tests/fremend_fixture.h"
 
@@ -27,11 +23,6 @@ using ::testing::Not;
 
 constexpr double kDay = 86400;
 constexpr double kStart = 1699920000;  // midnight UTC
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 // 1 from 8:00 to 18:00 UTC.
 float DayPattern(double t) {
@@ -272,33 +263,44 @@ TEST_F(FremenctlTest, UpdateStartsOrWaitsWithProgressAndSummary) {
   EXPECT_EQ(Run({"update", "--map", "lab", "--poll-interval", "0"}).exit_code, 2);
 }
 
-TEST_F(FremenctlTest, UpdateWaitExitsNonZeroWhenTheJobIsCancelled) {
-  // Updates run one at a time: small's job waits behind a big one, long enough to cancel it.
+TEST_F(FremenctlTest, OperationsListWaitAndCancel) {
+  // Updates run one at a time: small's job is queued behind big's and cancelled there, at once (a
+  // queued job ends as it is cancelled), so fremenctl then follows a job whose end is known.
   MakeDynamicGrid("big", 1024, 512);
   CreateGrid("small");
-  ASSERT_TRUE(client_->RunUpdate("big").ok());
+  auto running = client_->RunUpdate("big");
+  ASSERT_TRUE(running.ok()) << running.status();
   auto queued = client_->RunUpdate("small");
   ASSERT_TRUE(queued.ok()) << queued.status();
   ASSERT_EQ(queued->stage(), v1::OPERATION_STAGE_QUEUED);
+  RunResult cancel = Run({"operations", "cancel", queued->name(), "--map", "small"});
+  ASSERT_EQ(cancel.exit_code, 0) << cancel.err;
+  EXPECT_EQ(cancel.out, absl::StrCat(queued->name(), " small done: cancelled (RunUpdate)\n"));
 
-  // fremenctl joins the queued job (RunUpdate answers the running one) and follows it.
-  const std::string err_path = dir_.Path("wait.err");
-  auto waiting = std::async(std::launch::async, [&] {
-    RunOptions options;
-    options.stderr_copy_path = err_path;
-    return Run({"update", "--map", "small", "--wait", "--poll-interval", "0.02", "--line-interval", "0"}, options);
-  });
-  // Once it has printed its first progress line, cancel the job under it.
-  const absl::Time give_up = absl::Now() + absl::Seconds(60);
-  while (ReadAll(err_path).find("update of small") == std::string::npos && absl::Now() < give_up) {
-    absl::SleepFor(absl::Milliseconds(10));
-  }
-  ASSERT_THAT(ReadAll(err_path), HasSubstr("update of small: queued"));
-  auto cancelled = client_->CancelOperation("small", queued->name());
-  ASSERT_TRUE(cancelled.ok()) << cancelled.status();
-  const RunResult r = waiting.get();
-  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
-  EXPECT_THAT(r.err, HasSubstr(absl::StrCat("update of small (", queued->name(), ") was cancelled")));
+  // Following a cancelled job exits 1 and says so, as `update --wait` does (the same code).
+  RunResult wait_cancelled = Run({"operations", "wait", queued->name(), "--map", "small"});
+  EXPECT_EQ(wait_cancelled.exit_code, 1) << wait_cancelled.out;
+  EXPECT_THAT(wait_cancelled.err,
+              HasSubstr(absl::StrCat("fremenctl operations wait: update of small (", queued->name(), ") was cancelled")));
+  RunResult wait_done = Run({"operations", "wait", running->name(), "--map", "big", "--poll-interval", "0.05"});
+  ASSERT_EQ(wait_done.exit_code, 0) << wait_done.err;
+  EXPECT_THAT(wait_done.out, HasSubstr("done: 524288 states published"));
+
+  RunResult list = Run({"operations", "list"});
+  ASSERT_EQ(list.exit_code, 0) << list.err;
+  EXPECT_THAT(list.out, HasSubstr(absl::StrCat(running->name(), " big done: 524288 states published (RunUpdate)\n")));
+  EXPECT_THAT(list.out, HasSubstr(absl::StrCat(queued->name(), " small done: cancelled (RunUpdate)\n")));
+  RunResult only_small = Run({"operations", "list", "--map", "small", "--json"});
+  ASSERT_EQ(only_small.exit_code, 0) << only_small.err;
+  EXPECT_THAT(only_small.out, HasSubstr("\"map\":\"small\""));
+  EXPECT_THAT(only_small.out, Not(HasSubstr("\"map\":\"big\"")));
+  EXPECT_EQ(Run({"operations", "list", "--running"}).out, "");
+
+  RunResult unknown = Run({"operations", "wait", "operations/update-nope-1", "--map", "nope"});
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_THAT(unknown.err, HasSubstr("fremenctl operations wait"));
+  EXPECT_EQ(Run({"operations", "cancel", queued->name()}).exit_code, 2);  // --map is required
+  EXPECT_EQ(Run({"operations"}).exit_code, 2);                           // a subcommand is required
 }
 
 // --- backup, restore ---

@@ -12,6 +12,7 @@
 #include "client/fremenctl/ingest_command.h"
 #include "client/fremenctl/maps_command.h"
 #include "client/fremenctl/model_command.h"
+#include "client/fremenctl/operations_command.h"
 #include "client/fremenctl/query_commands.h"
 #include "client/fremenctl/region_command.h"
 #include "client/fremenctl/salvage_command.h"
@@ -30,6 +31,7 @@ int main(int argc, char** argv) {
   fremen::client::RegisterAnomaliesCommand(app);
   fremen::client::RegisterStatsCommand(app);
   fremen::client::RegisterUpdateCommand(app);
+  fremen::client::RegisterOperationsCommand(app);
   fremen::client::RegisterBackupCommand(app);
   fremen::client::RegisterRestoreCommand(app);
   fremen::client::RegisterStatusCommand(app);

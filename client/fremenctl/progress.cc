@@ -54,6 +54,22 @@ std::string ProgressLine(const v1::Operation& op) {
                          p.states_done(), p.states_total(), Percent(p), p.rate(), FormatEta(p.eta_seconds()));
 }
 
+std::string OperationLine(const v1::Operation& op) {
+  std::string what;
+  if (!op.done()) {
+    what = absl::StrFormat("%d/%d states (%.0f%%)", op.progress().states_done(), op.progress().states_total(),
+                           Percent(op.progress()));
+  } else if (op.error().code() == 1 /* CANCELLED */) {
+    what = "cancelled";
+  } else if (op.error().code() != 0) {
+    what = absl::StrCat("failed: ", op.error().message());
+  } else {
+    what = absl::StrCat(op.update().states_published(), " states published");
+  }
+  return absl::StrCat(op.name(), " ", op.map(), " ", StageName(op), ": ", what,
+                      op.trigger().empty() ? "" : absl::StrCat(" (", op.trigger(), ")"));
+}
+
 std::string UpdateSummary(const v1::Operation& op) {
   if (op.error().code() == 1 /* CANCELLED */) {
     return absl::StrCat("update of ", op.map(), " (", op.name(), ") was cancelled",

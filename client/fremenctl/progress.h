@@ -16,6 +16,9 @@ std::string FormatEta(double seconds);
 std::string ProgressBar(const v1::Operation& op, int width = 30);
 // "update of lab: running, 1200/5000 states (24%), 3400 states/s, ETA 0:02".
 std::string ProgressLine(const v1::Operation& op);
+// One line of `fremenctl operations list`: "operations/update-lab-2 lab done: 5000 states published
+// (RunUpdate)"; a queued or running one shows its progress, a failed one its error.
+std::string OperationLine(const v1::Operation& op);
 // The result of a finished update, several lines; or why it failed or was cancelled.
 std::string UpdateSummary(const v1::Operation& op);
 

@@ -60,5 +60,21 @@ TEST(ProgressTest, SummaryOfDoneFailedAndCancelled) {
   EXPECT_EQ(UpdateSummary(op), "update of lab (operations/3) failed: disk full");
 }
 
+TEST(ProgressTest, OperationLineShowsProgressResultOrError) {
+  v1::Operation op = Running(1200, 5000, 3400, 2.2);
+  op.set_trigger("schedule");
+  EXPECT_EQ(OperationLine(op), "operations/3 lab running: 1200/5000 states (24%) (schedule)");
+  op.set_done(true);
+  op.set_stage(v1::OPERATION_STAGE_DONE);
+  op.set_trigger("");
+  op.mutable_update()->set_states_published(5000);
+  EXPECT_EQ(OperationLine(op), "operations/3 lab done: 5000 states published");
+  op.mutable_error()->set_code(1);
+  EXPECT_EQ(OperationLine(op), "operations/3 lab done: cancelled");
+  op.mutable_error()->set_code(13);
+  op.mutable_error()->set_message("disk full");
+  EXPECT_EQ(OperationLine(op), "operations/3 lab done: failed: disk full");
+}
+
 }  // namespace
 }  // namespace fremen::client

@@ -1,16 +1,12 @@
 #include "client/fremenctl/update_command.h"
 
-#include <unistd.h>
-
 #include <cstdio>
 #include <memory>
 #include <string>
 
 #include "absl/strings/str_cat.h"
-#include "absl/time/clock.h"
 #include "client/fremenctl/connection.h"
-#include "client/fremenctl/exit_codes.h"
-#include "client/fremenctl/progress.h"
+#include "client/fremenctl/operation_follow.h"
 
 namespace fremen::client {
 
@@ -23,36 +19,6 @@ struct UpdateArgs {
   double line_seconds = 10;
 };
 
-// Shows progress on stderr: redraws a bar on a terminal; elsewhere prints a line when the figures
-// change, at most every `line_interval` (a log should not get a line per poll).
-class ProgressDisplay {
- public:
-  explicit ProgressDisplay(absl::Duration line_interval)
-      : terminal_(isatty(STDERR_FILENO) == 1), line_interval_(line_interval) {}
-
-  void Show(const v1::Operation& op) {
-    if (terminal_) {
-      std::fprintf(stderr, "\r%s\033[K", ProgressBar(op).c_str());
-      if (op.done()) std::fprintf(stderr, "\n");
-    } else {
-      const std::string line = ProgressLine(op);
-      const absl::Time now = absl::Now();
-      if (line != last_line_ && (op.done() || now - last_time_ >= line_interval_)) {
-        std::fprintf(stderr, "%s\n", line.c_str());
-        last_line_ = line;
-        last_time_ = now;
-      }
-    }
-    std::fflush(stderr);
-  }
-
- private:
-  const bool terminal_;
-  const absl::Duration line_interval_;
-  std::string last_line_;
-  absl::Time last_time_ = absl::InfinitePast();
-};
-
 void RunUpdate(const UpdateArgs& a) {
   Client client = ConnectOrExit("update");
   auto op = client.RunUpdate(a.map, GlobalCall());
@@ -62,18 +28,10 @@ void RunUpdate(const UpdateArgs& a) {
                 a.map.c_str(), a.map.c_str());
     return;
   }
-  ProgressDisplay display(absl::Seconds(a.line_seconds));
-  WaitOptions wait;
-  wait.poll_interval = absl::Seconds(a.poll_seconds);
-  wait.on_progress = [&display](const v1::Operation& o) { display.Show(o); };
-  auto done = client.WaitOperation(a.map, op->name(), wait, GlobalCall());
-  if (!done.ok()) FailCall("update", absl::StrCat("following ", op->name()), done.status(), a.map);
-  const std::string summary = UpdateSummary(*done);
-  if (done->error().code() != 0) {
-    std::fprintf(stderr, "fremenctl update: %s\n", summary.c_str());
-    throw CLI::RuntimeError(kExitFailure);
-  }
-  std::printf("%s\n", summary.c_str());
+  FollowOptions follow;
+  follow.poll_interval = absl::Seconds(a.poll_seconds);
+  follow.line_interval = absl::Seconds(a.line_seconds);
+  FollowOperation(client, "update", a.map, op->name(), follow);
 }
 
 }  // namespace

@@ -1,12 +1,8 @@
 #include "storage/lmdb/lmdb_probe.h"
 
-#include <fcntl.h>
 #include <lmdb.h>
-#include <poll.h>
 #include <signal.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -16,6 +12,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "absl/time/clock.h"
+#include "storage/isolated_child.h"
 #include "storage/lmdb/lmdb_env.h"
 
 namespace fremen::storage {
@@ -32,17 +29,7 @@ constexpr size_t kMaxOutput = 64 << 10;
 
 // --- the child: LMDB's C API, write() and _exit() only ---
 
-int probe_fd = -1;
-
-void WriteAll(const char* data, size_t size) {
-  while (size > 0) {
-    const ssize_t n = write(probe_fd, data, size);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return;
-    data += n;
-    size -= static_cast<size_t>(n);
-  }
-}
+int probe_fd = -1;  // OnAssert has no other way to it
 
 void WriteLine(char tag, long number) {
   char line[32];
@@ -57,16 +44,16 @@ void WriteLine(char tag, long number) {
   if (negative) line[--at] = '-';
   line[--at] = ' ';
   line[--at] = tag;
-  WriteAll(line + at, sizeof(line) - at);
+  (void)WriteAll(probe_fd, std::string_view(line + at, sizeof(line) - at));
 }
 
 // LMDB calls this instead of printing to stderr (whose lock a thread of the parent may have held at fork) before it
 // aborts.
 void OnAssert(MDB_env*, const char* message) {
   const char tag[2] = {kAssertTag, ' '};
-  WriteAll(tag, 2);
-  WriteAll(message, std::strlen(message));
-  WriteAll("\n", 1);
+  (void)WriteAll(probe_fd, std::string_view(tag, 2));
+  (void)WriteAll(probe_fd, message);
+  (void)WriteAll(probe_fd, "\n");
   signal(SIGABRT, SIG_DFL);
   raise(SIGABRT);
   _exit(3);
@@ -124,60 +111,30 @@ int WalkEnvironment(const char* dir) {
   return rc;
 }
 
-[[noreturn]] void ChildMain(const std::vector<const char*>& dirs, int fd) {
+// The child's work: false after an LMDB error (reported on the pipe).
+bool WalkAll(const std::vector<const char*>& dirs, int fd) {
   probe_fd = fd;
   for (int s : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL}) signal(s, SIG_DFL);
   for (size_t i = 0; i < dirs.size(); ++i) {
     WriteLine(kFileTag, static_cast<long>(i));
     if (const int rc = WalkEnvironment(dirs[i]); rc != MDB_SUCCESS) {
       WriteLine(kErrorTag, rc);
-      _exit(1);
+      return false;
     }
   }
-  _exit(0);
+  return true;
 }
 
 // --- the parent ---
 
-struct ChildReport {
-  bool timed_out = false;
-  int wait_status = 0;
-  std::string output;
-};
-
-ChildReport ReadAndReap(pid_t pid, int fd, absl::Duration timeout) {
-  ChildReport report;
-  const absl::Time deadline = absl::Now() + timeout;
-  char buffer[4096];
-  for (;;) {
-    const int64_t left_ms = absl::ToInt64Milliseconds(deadline - absl::Now());
-    if (left_ms <= 0) {
-      report.timed_out = true;
-      break;
-    }
-    pollfd p{fd, POLLIN, 0};
-    const int ready = poll(&p, 1, static_cast<int>(std::min<int64_t>(left_ms, 60'000)));
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready <= 0) continue;
-    const ssize_t n = read(fd, buffer, sizeof(buffer));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;  // EOF: the child is gone
-    if (report.output.size() < kMaxOutput) report.output.append(buffer, static_cast<size_t>(n));
-  }
-  if (report.timed_out) kill(pid, SIGKILL);
-  while (waitpid(pid, &report.wait_status, 0) < 0 && errno == EINTR) {
-  }
-  return report;
-}
-
-absl::Status Interpret(const ChildReport& report, const std::vector<std::string>& dirs, absl::Duration timeout) {
-  if (!report.timed_out && WIFEXITED(report.wait_status) && WEXITSTATUS(report.wait_status) == 0) {
-    return absl::OkStatus();
-  }
+// `output` is what the child wrote; `timed_out` that it was killed at the deadline, else `exit` how it ended.
+absl::Status Interpret(const std::string& output, bool timed_out, const ChildExit& exit,
+                       const std::vector<std::string>& dirs, absl::Duration timeout) {
+  if (!timed_out && exit.ok()) return absl::OkStatus();
   size_t index = 0;
   int lmdb_error = 0;
   std::string assertion;
-  for (absl::string_view line : absl::StrSplit(report.output, '\n', absl::SkipEmpty())) {
+  for (absl::string_view line : absl::StrSplit(output, '\n', absl::SkipEmpty())) {
     if (line.size() < 2) continue;
     const absl::string_view rest = line.substr(2);
     if (line[0] == kFileTag) {
@@ -189,12 +146,12 @@ absl::Status Interpret(const ChildReport& report, const std::vector<std::string>
     }
   }
   const std::string file = absl::StrCat(dirs[std::min(index, dirs.size() - 1)], "/data.mdb");
-  if (report.timed_out) {
+  if (timed_out) {
     return absl::DataLossError(
         absl::StrCat(file, " is damaged: LMDB did not finish reading it within ", absl::FormatDuration(timeout)));
   }
-  if (WIFSIGNALED(report.wait_status)) {
-    const int signal_number = WTERMSIG(report.wait_status);
+  if (exit.signal != 0) {
+    const int signal_number = exit.signal;
     return absl::DataLossError(absl::StrCat(file, " is damaged: LMDB aborted reading it (signal ", signal_number, ", ",
                                             strsignal(signal_number), ")",
                                             assertion.empty() ? "" : absl::StrCat(": ", assertion)));
@@ -209,7 +166,7 @@ absl::Status Interpret(const ChildReport& report, const std::vector<std::string>
     return status;
   }
   return absl::InternalError(
-      absl::StrCat("the probe of ", file, " ended with exit status ", WEXITSTATUS(report.wait_status)));
+      absl::StrCat("the probe of ", file, " ended with exit status ", exit.exit_code));
 }
 
 }  // namespace
@@ -224,25 +181,17 @@ absl::Status ProbeEnvironments(const std::vector<std::string>& dirs, const Probe
   // Everything the child needs is prepared before the fork.
   std::vector<const char*> paths;
   for (const std::string& dir : present) paths.push_back(dir.c_str());
-  int fds[2];
-  if (pipe2(fds, O_CLOEXEC) != 0) {
-    return absl::UnavailableError(absl::StrCat("cannot probe LMDB files: pipe: ", std::strerror(errno)));
+  std::string output;
+  auto exit = RunIsolated([&](int fd) { return WalkAll(paths, fd); },
+                          [&](std::string_view chunk) {
+                            if (output.size() < kMaxOutput) output.append(chunk);
+                          },
+                          absl::Now() + options.timeout);
+  const bool timed_out = absl::IsDeadlineExceeded(exit.status());
+  if (!exit.ok() && !timed_out) {
+    return absl::UnavailableError(absl::StrCat("cannot probe LMDB files: ", exit.status().message()));
   }
-  const pid_t pid = fork();
-  if (pid < 0) {
-    const int error = errno;
-    close(fds[0]);
-    close(fds[1]);
-    return absl::UnavailableError(absl::StrCat("cannot probe LMDB files: fork: ", std::strerror(error)));
-  }
-  if (pid == 0) {
-    close(fds[0]);
-    ChildMain(paths, fds[1]);
-  }
-  close(fds[1]);
-  const ChildReport report = ReadAndReap(pid, fds[0], options.timeout);
-  close(fds[0]);
-  return Interpret(report, present, options.timeout);
+  return Interpret(output, timed_out, exit.value_or(ChildExit{}), present, options.timeout);
 }
 
 }  // namespace fremen::storage

@@ -1,0 +1,24 @@
+// Following an operation to its end, as `fremenctl update --wait` and `fremenctl operations wait`
+// do: progress on stderr (a bar redrawn in place on a terminal, plain lines otherwise, at most one
+// per line interval), then the summary on stdout; a job that failed or was cancelled prints its
+// summary on stderr and exits 1 (kExitFailure), so that a cron job can alert on it.
+#pragma once
+
+#include <string>
+
+#include "absl/time/time.h"
+#include "client/lib/client.h"
+
+namespace fremen::client {
+
+struct FollowOptions {
+  absl::Duration poll_interval = absl::Milliseconds(500);
+  // Not on a terminal: the least time between two progress lines.
+  absl::Duration line_interval = absl::Seconds(10);
+};
+
+// `command` names the fremenctl command in error messages ("update", "operations wait").
+void FollowOperation(const Client& client, const std::string& command, const std::string& map,
+                     const std::string& name, const FollowOptions& options);
+
+}  // namespace fremen::client
