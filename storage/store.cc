@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "storage/data_dir_format.h"
 #include "storage/lmdb/lmdb_probe.h"
 #include "storage/verify.h"
 
@@ -29,7 +30,12 @@ absl::Status Failed(const std::string& name, const absl::Status& open_error) {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& data_dir, const StoreOptions& options) {
+  // Before anything is created or opened: a directory another version laid out is refused as it is.
+  auto format = ReadDataDirFormat(options.env, data_dir);
+  if (!format.ok()) return format.status();
+  if (*format != 0 && *format != kDataDirFormat) return UnreadableFormatError(data_dir, *format);
   std::error_code error;
+  const bool had_catalog = fs::exists(data_dir + "/catalog/data.mdb", error);
   fs::create_directories(data_dir + "/maps", error);
   if (error) return absl::InternalError(absl::StrCat("cannot create ", data_dir, "/maps: ", error.message()));
   if (options.probe_before_open) {
@@ -46,6 +52,11 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& data_dir, 
   std::vector<MapInfo> all;
   std::vector<DamagedCatalogEntry> damaged;
   if (absl::Status listed = store->ListCatalog(all, damaged); !listed.ok()) return listed;
+  if (*format == 0) {
+    // No FORMAT: a new directory, one this format wrote before it kept the file, or format 1.
+    if (had_catalog && all.empty() && !damaged.empty()) return UnreadableFormatError(data_dir, 1);
+    if (absl::Status written = WriteDataDirFormat(options.env, data_dir); !written.ok()) return written;
+  }
   std::lock_guard lock(store->mutex_);
   for (const MapInfo& info : all) {
     if (auto map = store->OpenMap(info); !map.ok()) {

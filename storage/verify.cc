@@ -20,6 +20,7 @@
 #include "storage/batch.h"
 #include "storage/catalog.h"
 #include "storage/cell_key.h"
+#include "storage/data_dir_format.h"
 #include "storage/dedup_table.h"
 #include "storage/isolated_child.h"
 #include "storage/lmdb/lmdb_env.h"
@@ -521,6 +522,13 @@ bool DataDirVerifyReport::clean() const {
 
 DataDirVerifyReport VerifyDataDir(const std::string& data_dir, const VerifyOptions& options) {
   DataDirVerifyReport report;
+  // No FORMAT file is no problem: the next store to open the directory writes it (data_dir_format.h).
+  if (auto format = ReadDataDirFormat(Env::Default(), data_dir); !format.ok()) {
+    report.problems.push_back({"FORMAT", "", std::string(format.status().message())});
+  } else if (*format != 0 && *format != kDataDirFormat) {
+    report.problems.push_back({"FORMAT", "", std::string(UnreadableFormatError(data_dir, *format).message())});
+    return report;
+  }
   auto catalog = Catalog::OpenReadOnly(data_dir + "/catalog");
   if (!catalog.ok()) {
     report.problems.push_back({"catalog/data.mdb", "", absl::StrCat("cannot be opened: ", catalog.status().message())});
@@ -545,7 +553,7 @@ DataDirVerifyReport VerifyDataDir(const std::string& data_dir, const VerifyOptio
     report.problems.push_back({"catalog/data.mdb", "", absl::StrCat("cannot be read to its end: ", walked.message())});
   }
   catalog->reset();
-  // Directories the catalog does not name: a store opening this data directory removes them.
+  // Directories the catalog does not name: a store opening this data directory reports them and leaves them.
   if (DIR* d = opendir((data_dir + "/maps").c_str())) {
     while (dirent* e = readdir(d)) {
       const std::string entry = e->d_name;

@@ -1,0 +1,32 @@
+// The layout version of a data directory, kept in <data dir>/FORMAT ("fremen data directory format
+// 2"), so that a fremend refuses, with a message that says so, a directory that another version laid
+// out differently, instead of reading its every record as damage (docs/storage.md, "Data directory
+// format").
+//
+// Format 2 is the first with a checksum in every LMDB record. Format 1 (no record checksums, no
+// FORMAT file) cannot be read by this version; a directory without a FORMAT file whose catalog
+// records all fail their checksum is taken for one and refused, nothing changed.
+// Thread-safety: pure functions over the file system.
+#pragma once
+
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "storage/env/env.h"
+
+namespace fremen::storage {
+
+inline constexpr int kDataDirFormat = 2;
+
+// The directory's format: the number in its FORMAT file, 0 when it has none.
+// DataLoss naming the file when the file says something else than "fremen data directory format N".
+absl::StatusOr<int> ReadDataDirFormat(Env* env, const std::string& data_dir);
+
+// Writes FORMAT with kDataDirFormat, atomically and durably.
+absl::Status WriteDataDirFormat(Env* env, const std::string& data_dir);
+
+// FailedPrecondition for a format this version does not read, naming both and what to do.
+absl::Status UnreadableFormatError(const std::string& data_dir, int format);
+
+}  // namespace fremen::storage
