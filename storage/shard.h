@@ -209,8 +209,12 @@ class Shard {
   void ObserveBesidesSpectrum(uint32_t d, double t, float value);
   uint32_t AddDynamic(uint32_t slot);
   void MarkDirty(uint32_t slot);
-  float PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f, const float* sin_f,
-                      const PredictOptions& options) const;
+  // p(t) of the state behind a handle (see kStaticHandle).
+  float PredictHandle(uint32_t handle, const model::PhasorTable& table, const PredictOptions& options) const;
+  // out[i] = p(t) of dynamic state dynamic[i], each with a published model: the region kernel
+  // (model/region_predict.h, what the benchmark measures), then persistence when asked for.
+  void PredictPublished(std::span<const uint32_t> dynamic, const model::PhasorTable& table,
+                        const PredictOptions& options, float* out) const;
   // Publishes one dynamic state (see BeginPublication) and clears its flags; `history_updated`:
   // the caller has updated its lossless history already (outside the lock). REQUIRES: mutex_ held
   // exclusively.

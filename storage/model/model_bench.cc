@@ -261,6 +261,24 @@ void BM_PredictU8(benchmark::State& state) {
 }
 BENCHMARK(BM_PredictU8)->Arg(2)->Arg(5)->Arg(-1)->Unit(benchmark::kMicrosecond);
 
+// The listed form a shard's box query runs: the same records, a brick (512) at a time, in an order
+// shuffled within each brick as a box visits states that were promoted in the order they changed.
+void BM_PredictListed(benchmark::State& state) {
+  static const std::vector<uint32_t> records = [] {
+    std::vector<uint32_t> r(Models().size());
+    for (size_t i = 0; i < r.size(); ++i) r[i] = static_cast<uint32_t>(i);
+    std::mt19937_64 rng(3);
+    for (size_t b = 0; b < r.size(); b += 512) std::shuffle(r.begin() + b, r.begin() + std::min(r.size(), b + 512), rng);
+    return r;
+  }();
+  RunPredictions<float>(state, [](const CompactModels& m, const PhasorTable& p, int order, float* out) {
+    for (size_t b = 0; b < records.size(); b += 512) {
+      PredictRecords(m, std::span(records).subspan(b, std::min<size_t>(512, records.size() - b)), p, order, out + b);
+    }
+  });
+}
+BENCHMARK(BM_PredictListed)->Arg(2)->Arg(5)->Arg(-1)->Unit(benchmark::kMicrosecond);
+
 // Order choice + top-L publication of kScanCells states (errors choose orders 0..5 at random).
 void BM_Publish(benchmark::State& state) {
   const RecordArena& arena = BigArena();
