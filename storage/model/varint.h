@@ -44,7 +44,31 @@ inline uint64_t ZigZagEncode64(int64_t v) {
 }
 inline int64_t ZigZagDecode64(uint64_t v) { return static_cast<int64_t>(v >> 1) ^ -static_cast<int64_t>(v & 1); }
 
-// Little-endian fixed-width values; float and double by their IEEE-754 bit patterns.
+// Little-endian fixed-width values at a position in raw bytes (REQUIRES: 4 or 8 bytes there), for
+// formats framed outside a ByteReader: the log's record headers, the LMDB record checksum, the
+// salvage child's frames.
+inline void EncodeFixed32(void* dst, uint32_t v) {
+  auto* p = static_cast<unsigned char*>(dst);
+  for (size_t i = 0; i < 4; ++i) p[i] = static_cast<unsigned char>(v >> (8 * i));
+}
+inline void EncodeFixed64(void* dst, uint64_t v) {
+  auto* p = static_cast<unsigned char*>(dst);
+  for (size_t i = 0; i < 8; ++i) p[i] = static_cast<unsigned char>(v >> (8 * i));
+}
+inline uint32_t DecodeFixed32(const void* src) {
+  const auto* p = static_cast<const unsigned char*>(src);
+  uint32_t v = 0;
+  for (size_t i = 0; i < 4; ++i) v |= uint32_t{p[i]} << (8 * i);
+  return v;
+}
+inline uint64_t DecodeFixed64(const void* src) {
+  const auto* p = static_cast<const unsigned char*>(src);
+  uint64_t v = 0;
+  for (size_t i = 0; i < 8; ++i) v |= uint64_t{p[i]} << (8 * i);
+  return v;
+}
+
+// Appended little-endian fixed-width values; float and double by their IEEE-754 bit patterns.
 void PutFixed32(std::string* out, uint32_t v);
 void PutFixed64(std::string* out, uint64_t v);
 void PutFloat(std::string* out, float v);

@@ -116,6 +116,20 @@ TEST(Varint, FixedWidthValuesAreLittleEndian) {
   EXPECT_TRUE(reader.Finish().ok());
 }
 
+TEST(Varint, FixedWidthValuesInRawBytesAreLittleEndianToo) {
+  unsigned char bytes[12] = {};
+  EncodeFixed32(bytes, 0x04030201u);
+  EncodeFixed64(bytes + 4, 0x0807060504030201ull);
+  const unsigned char want[12] = {1, 2, 3, 4, 1, 2, 3, 4, 5, 6, 7, 8};
+  EXPECT_EQ(std::string(reinterpret_cast<char*>(bytes), 12), std::string(reinterpret_cast<const char*>(want), 12));
+  EXPECT_EQ(DecodeFixed32(bytes), 0x04030201u);
+  EXPECT_EQ(DecodeFixed64(bytes + 4), 0x0807060504030201ull);
+  // High bytes survive (no sign extension through char).
+  EncodeFixed64(bytes, 0xfffefdfcfbfaf9f8ull);
+  EXPECT_EQ(DecodeFixed64(bytes), 0xfffefdfcfbfaf9f8ull);
+  EXPECT_EQ(DecodeFixed32(bytes + 4), 0xfffefdfcu);
+}
+
 TEST(Varint, ByteReaderErrorsAreStickyAndNameTheField) {
   std::string bytes;
   PutVarint64(&bytes, 5);
