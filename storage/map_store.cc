@@ -118,18 +118,14 @@ absl::Status MapStore::Recover() {
     if (!batch.ok()) return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", batch.status().message()));
     dedup_.Record(batch->writer_id, batch->sequence,
                   BatchFingerprint({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1}));
-    Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}};
+    Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}, {}};
     pending.ack = Classify(info_, pending.batch, pending.accept);
     SplitByShard(pending);
     const ScanContext scan(settings_->periods, pending.batch.time);
     for (uint32_t s = 0; s < shards_.size(); ++s) {
       if (shards_[s]->checkpoint_lsn() >= lsn) continue;  // the checkpoint has it already
       shards_[s]->Apply(scan, pending.keys[s], pending.values[s]);
-      std::vector<StateLabel> mine;
-      for (const StateLabel& l : pending.batch.labels) {
-        if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);
-      }
-      shards_[s]->ApplyLabels(mine);
+      shards_[s]->ApplyLabels(pending.labels[s]);
     }
     return absl::OkStatus();
   }, options_.env);
@@ -166,7 +162,7 @@ absl::Status MapStore::Recover() {
 }
 
 MapStore::Pending MapStore::Prepare(ObservationBatch batch, AckCallback done) const {
-  Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}};
+  Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}, {}};
   pending.ack = Classify(info_, pending.batch, pending.accept);
   pending.record.push_back(kBatchRecord);
   pending.record += EncodeBatch(pending.batch);
@@ -178,13 +174,11 @@ MapStore::Pending MapStore::Prepare(ObservationBatch batch, AckCallback done) co
 void MapStore::SplitByShard(Pending& pending) const {
   std::vector<std::vector<uint64_t>>& keys = pending.keys;
   std::vector<std::vector<float>>& values = pending.values;
-  keys.resize(info_.shards);
-  values.resize(info_.shards);
-  for (uint32_t s = 0; s < info_.shards; ++s) {
-    keys[s].clear();
-    values[s].clear();
-  }
+  keys.assign(info_.shards, {});
+  values.assign(info_.shards, {});
+  pending.labels.assign(info_.shards, {});
   const ObservationBatch& b = pending.batch;
+  for (const StateLabel& l : b.labels) pending.labels[ShardOf(l.key, info_.shards)].push_back(l);
   for (size_t i = 0; i < b.keys.size(); ++i) {
     if (!pending.accept[i]) continue;
     const uint32_t s = ShardOf(b.keys[i], info_.shards);
@@ -475,11 +469,7 @@ void MapStore::ApplyGroup(std::vector<Pending>& group) {
     workers_->RunOnAll([&](uint32_t s) {
       for (size_t b = 0; b < fresh.size(); ++b) {
         shards_[s]->Apply(scans[b], fresh[b]->keys[s], fresh[b]->values[s]);
-        std::vector<StateLabel> mine;
-        for (const StateLabel& l : fresh[b]->batch.labels) {
-          if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);
-        }
-        if (!mine.empty()) shards_[s]->ApplyLabels(mine);
+        if (!fresh[b]->labels[s].empty()) shards_[s]->ApplyLabels(fresh[b]->labels[s]);
       }
     });
   }

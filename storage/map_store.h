@@ -175,6 +175,7 @@ class MapStore {
     std::string record;                        // the log record
     std::vector<std::vector<uint64_t>> keys;   // accepted observations by shard
     std::vector<std::vector<float>> values;
+    std::vector<std::vector<StateLabel>> labels;  // the batch's labels by shard
     uint64_t fingerprint = 0;  // BatchFingerprint of the record's batch
   };
   // Requests the committer serves between groups, in order.
@@ -219,7 +220,7 @@ class MapStore {
   void ContinuePublication();
   void FinishPublication();
   absl::StatusOr<uint64_t> RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress = nullptr);
-  // Splits the accepted observations of a batch by shard.
+  // Splits the accepted observations and the labels of a batch by shard.
   void SplitByShard(Pending& pending) const;
   // Classifies, encodes and splits a batch.
   Pending Prepare(ObservationBatch batch, AckCallback done) const;
