@@ -635,22 +635,7 @@ absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStore::TopN(const std
 MapStats MapStore::Stats() const {
   MapStats stats;
   stats.totals.order_histogram.assign(settings_->max_order + 1, 0);
-  for (const auto& shard : shards_) {
-    const ShardStats s = shard->Stats();
-    stats.totals.states += s.states;
-    stats.totals.dynamic_states += s.dynamic_states;
-    stats.totals.observations += s.observations;
-    stats.totals.disk_bytes += s.disk_bytes;
-    stats.totals.memory_bytes += s.memory_bytes;
-    stats.totals.wide_states += s.wide_states;
-    stats.totals.prediction_error_sum += s.prediction_error_sum;
-    stats.totals.prediction_error_states += s.prediction_error_states;
-    stats.totals.estimation_wrong += s.estimation_wrong;
-    stats.totals.estimation_observed += s.estimation_observed;
-    stats.totals.lossless_prediction_wrong += s.lossless_prediction_wrong;
-    stats.totals.lossless_prediction_observed += s.lossless_prediction_observed;
-    for (size_t l = 0; l < s.order_histogram.size(); ++l) stats.totals.order_histogram[l] += s.order_histogram[l];
-  }
+  for (const auto& shard : shards_) stats.totals += shard->Stats();
   {
     // The committer owns the log; its counters are read racily but only for reporting.
     stats.log_bytes = wal_->bytes();

@@ -53,6 +53,7 @@
 #include "storage/model/state_model.h"
 #include "storage/model/static_state.h"
 #include "storage/model/wide_bodies.h"
+#include "storage/shard_stats.h"
 
 namespace fremen::storage {
 
@@ -82,22 +83,6 @@ struct StateSnapshot {
   std::optional<model::CompactStateModel> model;  // when dynamic
   std::optional<model::LosslessHistory> lossless;
   std::string name, group;
-};
-
-struct ShardStats {
-  uint64_t states = 0;
-  uint64_t dynamic_states = 0;
-  uint64_t observations = 0;  // Σ n over states
-  uint64_t disk_bytes = 0;
-  uint64_t memory_bytes = 0;
-  uint64_t wide_states = 0;  // dynamic states whose spectrum is folded in double (model/wide_bodies.h)
-  std::vector<uint64_t> order_histogram;  // selected order of dynamic published states, 0..L
-  double prediction_error_sum = 0;        // Σ ε_p(selected order) over dynamic states with evidence
-  uint64_t prediction_error_states = 0;
-  // Lossless maps (eq. 15 from the outlier sets): wrong and observed slots, over all history (ε_e)
-  // and since the last update (ε_p).
-  uint64_t estimation_wrong = 0, estimation_observed = 0;
-  uint64_t lossless_prediction_wrong = 0, lossless_prediction_observed = 0;
 };
 
 // The value an unobserved state predicts: no information either way.
