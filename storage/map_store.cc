@@ -13,6 +13,7 @@
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
 #include "storage/cell_key.h"
+#include "storage/parallel_shards.h"
 
 namespace fremen::storage {
 
@@ -33,18 +34,6 @@ absl::Status MakeDir(const std::string& dir) {
     return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", std::strerror(errno)));
   }
   return absl::OkStatus();
-}
-
-// Runs f(shard) for every shard, in parallel threads when the work is big enough to pay for them.
-void ForEachShardInParallel(size_t shards, bool parallel, const std::function<void(size_t)>& f) {
-  if (!parallel || shards == 1) {
-    for (size_t s = 0; s < shards; ++s) f(s);
-    return;
-  }
-  std::vector<std::thread> threads;
-  for (size_t s = 1; s < shards; ++s) threads.emplace_back(f, s);
-  f(0);
-  for (std::thread& t : threads) t.join();
 }
 
 }  // namespace
@@ -551,14 +540,11 @@ absl::Status MapStore::WriteCheckpoint(uint64_t lsn, std::vector<Shard::Checkpoi
   // No backup copies the shards while they change, so that every copy is at one log position.
   std::lock_guard backup(backup_mutex_);
   if (absl::Status error = WriteError(); !error.ok()) return error;  // latched meanwhile: see StartCheckpoint
-  std::vector<std::future<absl::Status>> writes;
-  for (uint32_t s = 0; s < shards_.size(); ++s) {
-    writes.push_back(std::async(std::launch::async, [this, s, &images] { return shards_[s]->WriteCheckpoint(images[s]); }));
-  }
+  std::vector<absl::Status> writes(shards_.size());
+  ParallelForShards(shards_.size(), [&](size_t s) { writes[s] = shards_[s]->WriteCheckpoint(images[s]); });
   absl::Status status;
-  for (auto& w : writes) {
-    const absl::Status r = w.get();
-    if (status.ok()) status = r;
+  for (const absl::Status& w : writes) {
+    if (status.ok()) status = w;
   }
   if (status.ok()) {
     std::lock_guard wal(wal_mutex_);
@@ -596,8 +582,9 @@ absl::Status MapStore::PredictBox(const CellBox& box, double t, const PredictOpt
   }
   const model::PhasorTable table(settings_->periods, t);
   out.assign(box.cell_count(), kUnobservedProbability);
-  ForEachShardInParallel(shards_.size(), box.cell_count() >= (1u << 16),
-                         [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); });
+  ParallelForShards(
+      shards_.size(), [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); },
+      /*parallel=*/box.cell_count() >= (1u << 16));
   return absl::OkStatus();
 }
 
