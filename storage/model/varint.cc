@@ -49,15 +49,6 @@ size_t Varint64Length(uint64_t v) {
   return static_cast<size_t>((bits + 6) / 7);
 }
 
-absl::StatusOr<uint64_t> GetVarint64(std::string_view* in) {
-  uint64_t v = 0;
-  const char* problem = nullptr;
-  const size_t n = DecodeVarint(reinterpret_cast<const unsigned char*>(in->data()), in->size(), &v, &problem);
-  if (n == 0) return absl::DataLossError(problem);
-  in->remove_prefix(n);
-  return v;
-}
-
 void PutFixed32(std::string* out, uint32_t v) {
   char bytes[4];
   EncodeFixed32(bytes, v);

@@ -34,9 +34,6 @@ inline char* EncodeVarint64(char* dst, uint64_t v) {
 void PutVarint64(std::string* out, uint64_t v);
 // The encoded length of v in bytes (1..10).
 size_t Varint64Length(uint64_t v);
-// Reads a varint from the front of *in and advances past it. DataLoss on truncated, overlong (more
-// than 64 bits) or non-canonical (redundant trailing zero byte) input; *in is unchanged on error.
-absl::StatusOr<uint64_t> GetVarint64(std::string_view* in);
 
 // Zigzag maps signed to unsigned so that small magnitudes of either sign get short varints.
 inline uint64_t ZigZagEncode64(int64_t v) {
@@ -85,6 +82,8 @@ class ByteReader {
   // `record` names what is decoded in error messages, e.g. "lossless history".
   ByteReader(std::string_view bytes, std::string_view record) : bytes_(bytes), record_(record) {}
 
+  // A varint: fails (DataLoss) on truncated, overlong (more than 64 bits) or non-canonical
+  // (redundant trailing zero byte) input.
   uint64_t Varint(std::string_view field);
   uint8_t Byte(std::string_view field);
   uint32_t Fixed32(std::string_view field);
