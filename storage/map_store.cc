@@ -404,7 +404,7 @@ void MapStore::ApplyLoop() {
     Stage stage;
     {
       std::unique_lock lock(stage_mutex_);
-      if (publication_.has_value() && stages_.empty()) {
+      if (publication_.has_value() && stages_.empty() && !publication_held_) {
         // Publish a slice, then look for batches again: they wait at most one slice.
         lock.unlock();
         ContinuePublication();
@@ -416,6 +416,7 @@ void MapStore::ApplyLoop() {
     }
     stage_changed_.notify_all();
     ApplyGroup(stage.group);
+    if (!stage.group.empty()) publication_held_ = false;
     applied_lsn_ = std::max(applied_lsn_, stage.group_lsn);
     for (Control& c : stage.controls) {
       if (c.kind == Control::Kind::kPublish) {
@@ -488,6 +489,7 @@ void MapStore::StartPublication(Control control) {
   publication_total_ = 0;
   for (uint64_t n : marked) publication_total_ += n;
   publication_ = std::move(control);
+  publication_held_ = options_.publication_waits_for_a_batch;
   if (publication_->progress) publication_->progress(0, publication_total_);
   if (publication_total_ == 0) FinishPublication();
 }
