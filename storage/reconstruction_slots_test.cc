@@ -10,53 +10,35 @@ namespace {
 constexpr uint64_t kMax = 1'000'000;
 constexpr uint64_t kHeld = model::LosslessHistory::kMaxSlots;
 
+// The slots of [start, end) on a map of `period`-second slots from `origin`, field by field.
+void ExpectSlots(double origin, double period, double start, double end, const ReconstructionSlots& want) {
+  const auto got = SlotsOfInterval(origin, period, start, end, kMax);
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->count, want.count) << "[" << start << ", " << end << ")";
+  EXPECT_EQ(got->first_time, want.first_time) << "[" << start << ", " << end << ")";
+  EXPECT_EQ(got->begin, want.begin) << "[" << start << ", " << end << ")";
+  EXPECT_EQ(got->end, want.end) << "[" << start << ", " << end << ")";
+  EXPECT_EQ(got->offset, want.offset) << "[" << start << ", " << end << ")";
+}
+
 TEST(ReconstructionSlotsTest, EverySlotThatOverlapsTheInterval) {
   // Slots of 10 s from t = 100: [105, 131) overlaps slots 0 (100..110) to 3 (130..140).
-  auto slots = SlotsOfInterval(100, 10, 105, 131, kMax);
-  ASSERT_TRUE(slots.ok()) << slots.status();
-  EXPECT_EQ(slots->count, 4u);
-  EXPECT_EQ(slots->first_time, 100.0);
-  EXPECT_EQ(slots->begin, 0u);
-  EXPECT_EQ(slots->end, 4u);
-  EXPECT_EQ(slots->offset, 0u);
+  ExpectSlots(100, 10, 105, 131, {.count = 4, .first_time = 100, .begin = 0, .end = 4, .offset = 0});
   // Slot boundaries: [110, 130) is exactly slots 1 and 2.
-  slots = SlotsOfInterval(100, 10, 110, 130, kMax);
-  ASSERT_TRUE(slots.ok());
-  EXPECT_EQ(slots->count, 2u);
-  EXPECT_EQ(slots->first_time, 110.0);
-  EXPECT_EQ(slots->begin, 1u);
-  EXPECT_EQ(slots->end, 3u);
-  EXPECT_EQ(slots->offset, 0u);
+  ExpectSlots(100, 10, 110, 130, {.count = 2, .first_time = 110, .begin = 1, .end = 3, .offset = 0});
 }
 
 TEST(ReconstructionSlotsTest, SlotsBeforeTheOriginAreAnsweredButNotHeld) {
   // [70, 125): slots −3..2; the history holds 0..2, at answer index 3.
-  auto slots = SlotsOfInterval(100, 10, 70, 125, kMax);
-  ASSERT_TRUE(slots.ok());
-  EXPECT_EQ(slots->count, 6u);
-  EXPECT_EQ(slots->first_time, 70.0);
-  EXPECT_EQ(slots->begin, 0u);
-  EXPECT_EQ(slots->end, 3u);
-  EXPECT_EQ(slots->offset, 3u);
+  ExpectSlots(100, 10, 70, 125, {.count = 6, .first_time = 70, .begin = 0, .end = 3, .offset = 3});
   // Wholly before the origin: nothing held.
-  slots = SlotsOfInterval(100, 10, 20, 100, kMax);
-  ASSERT_TRUE(slots.ok());
-  EXPECT_EQ(slots->count, 8u);
-  EXPECT_EQ(slots->begin, slots->end);
+  ExpectSlots(100, 10, 20, 100, {.count = 8, .first_time = 20, .begin = 0, .end = 0, .offset = 0});
 }
 
 TEST(ReconstructionSlotsTest, SlotsPastTheLastAHistoryCanHoldAreNotHeld) {
   const double last = static_cast<double>(kHeld - 1);  // slot kHeld − 1 begins at t = last (origin 0, 1 s)
-  auto slots = SlotsOfInterval(0, 1, last, last + 5, kMax);
-  ASSERT_TRUE(slots.ok());
-  EXPECT_EQ(slots->count, 5u);
-  EXPECT_EQ(slots->begin, kHeld - 1);
-  EXPECT_EQ(slots->end, kHeld);
-  EXPECT_EQ(slots->offset, 0u);
-  slots = SlotsOfInterval(0, 1, last + 1, last + 3, kMax);
-  ASSERT_TRUE(slots.ok());
-  EXPECT_EQ(slots->count, 2u);
-  EXPECT_EQ(slots->begin, slots->end);
+  ExpectSlots(0, 1, last, last + 5, {.count = 5, .first_time = last, .begin = kHeld - 1, .end = kHeld, .offset = 0});
+  ExpectSlots(0, 1, last + 1, last + 3, {.count = 2, .first_time = last + 1, .begin = 0, .end = 0, .offset = 0});
 }
 
 TEST(ReconstructionSlotsTest, TooManySlotsIsInvalidArgument) {
