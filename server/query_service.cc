@@ -1,7 +1,6 @@
 #include "server/query_service.h"
 
 #include <algorithm>
-#include <cmath>
 #include <span>
 #include <vector>
 
@@ -13,6 +12,7 @@
 #include "server/state_refs.h"
 #include "storage/model/lossless_history.h"
 #include "storage/model/published_model.h"
+#include "storage/reconstruction_slots.h"
 
 namespace fremen::server {
 
@@ -34,7 +34,7 @@ constexpr MethodSpec kGetMapStats{"GetMapStats", Access::kRead, /*blocking=*/tru
 constexpr uint64_t kInlinePredictions = 4096;
 
 constexpr uint32_t kMaxTopStates = 10000;
-constexpr double kMaxReconstructSlots = 1e6;
+constexpr uint64_t kMaxReconstructSlots = 1'000'000;
 // A Reconstruct answer, one byte per slot per state, stays well inside the default message limit.
 constexpr uint64_t kMaxReconstructBytes = uint64_t{8} << 20;
 
@@ -180,15 +180,10 @@ absl::Status DoReconstruct(const StoreHandle& store, const grpc::ServerContextBa
     return absl::InvalidArgumentError(absl::StrCat("start_time must be < end_time, got [", request.start_time(), ", ",
                                                    request.end_time(), ")"));
   }
-  const double delta = info.lossless_sampling_period, origin = info.lossless_origin;
-  // The slots [s0, s1) that overlap [start_time, end_time).
-  const double s0 = std::floor((request.start_time() - origin) / delta);
-  const double s1 = std::ceil((request.end_time() - origin) / delta);
-  if (!(s1 - s0 <= kMaxReconstructSlots)) {
-    return absl::InvalidArgumentError(absl::StrCat("[start_time, end_time) spans ", s1 - s0, " slots of ", delta,
-                                                   " s; at most ", kMaxReconstructSlots, " per call"));
-  }
-  const uint64_t slots = static_cast<uint64_t>(s1 - s0);
+  auto window = storage::SlotsOfInterval(info.lossless_origin, info.lossless_sampling_period, request.start_time(),
+                                         request.end_time(), kMaxReconstructSlots);
+  if (!window.ok()) return window.status();
+  const uint64_t slots = window->count;
   if (RefCount(request.states()) * slots > kMaxReconstructBytes) {
     return absl::ResourceExhaustedError(absl::StrCat(RefCount(request.states()), " states × ", slots, " slots = ",
                                                      RefCount(request.states()) * slots, " bytes, more than the ",
@@ -196,23 +191,17 @@ absl::Status DoReconstruct(const StoreHandle& store, const grpc::ServerContextBa
   }
   auto keys = KeysOfRefs(info, request.states(), "states");
   if (!keys.ok()) return keys.status();
-  response.set_first_slot_time(origin + s0 * delta);
-  response.set_slot_seconds(delta);
-  // The part of [s0, s1) a history can hold: [0, kMaxSlots). s1 − s0 ≤ 1e6 keeps the casts exact.
-  const bool overlaps = s1 > 0 && s0 < static_cast<double>(model::LosslessHistory::kMaxSlots);
-  const int64_t first = overlaps ? static_cast<int64_t>(s0) : 0;
-  const uint64_t begin = overlaps ? static_cast<uint64_t>(std::max<int64_t>(first, 0)) : 0;
-  const uint64_t end =
-      overlaps ? std::min<uint64_t>(static_cast<uint64_t>(s1), model::LosslessHistory::kMaxSlots) : 0;
+  response.set_first_slot_time(window->first_time);
+  response.set_slot_seconds(info.lossless_sampling_period);
   std::vector<model::SlotState> scratch;
   for (uint64_t key : *keys) {
     std::string& bytes = *response.add_histories()->mutable_slots();
     bytes.assign(slots, static_cast<char>(model::SlotState::kUnobserved));
     const std::optional<storage::StateSnapshot> snapshot = (*map)->Snapshot(key);
-    if (!snapshot || !snapshot->lossless || begin >= end) continue;
-    scratch.resize(end - begin);
-    snapshot->lossless->ReconstructInto(begin, scratch);
-    std::transform(scratch.begin(), scratch.end(), bytes.begin() + (static_cast<int64_t>(begin) - first),
+    if (!snapshot || !snapshot->lossless || window->begin >= window->end) continue;
+    scratch.resize(window->end - window->begin);
+    snapshot->lossless->ReconstructInto(window->begin, scratch);
+    std::transform(scratch.begin(), scratch.end(), bytes.begin() + static_cast<int64_t>(window->offset),
                    [](model::SlotState s) { return static_cast<char>(s); });
   }
   return absl::OkStatus();

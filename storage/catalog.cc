@@ -30,6 +30,8 @@ absl::Status PutMap(LmdbTxn& txn, const MapInfo& info) {
 
 }  // namespace
 
+std::string MapDirIn(const std::string& data_dir, uint64_t id) { return absl::StrCat(data_dir, "/maps/", id); }
+
 absl::StatusOr<std::unique_ptr<Catalog>> Catalog::Open(const std::string& dir) {
   LmdbOptions options;
   options.initial_map_size = 16ull << 20;

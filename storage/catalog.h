@@ -32,6 +32,9 @@ struct MapPage {
   std::vector<DamagedCatalogEntry> damaged;
 };
 
+// Where the files of the map with `id` live in a data directory: <data dir>/maps/<id> (store.h).
+std::string MapDirIn(const std::string& data_dir, uint64_t id);
+
 inline constexpr size_t kMaxPageSize = 1000;
 inline constexpr size_t kDefaultPageSize = 100;
 

@@ -13,6 +13,7 @@
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
 #include "storage/cell_key.h"
+#include "storage/parallel_shards.h"
 
 namespace fremen::storage {
 
@@ -33,18 +34,6 @@ absl::Status MakeDir(const std::string& dir) {
     return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", std::strerror(errno)));
   }
   return absl::OkStatus();
-}
-
-// Runs f(shard) for every shard, in parallel threads when the work is big enough to pay for them.
-void ForEachShardInParallel(size_t shards, bool parallel, const std::function<void(size_t)>& f) {
-  if (!parallel || shards == 1) {
-    for (size_t s = 0; s < shards; ++s) f(s);
-    return;
-  }
-  std::vector<std::thread> threads;
-  for (size_t s = 1; s < shards; ++s) threads.emplace_back(f, s);
-  f(0);
-  for (std::thread& t : threads) t.join();
 }
 
 }  // namespace
@@ -118,18 +107,14 @@ absl::Status MapStore::Recover() {
     if (!batch.ok()) return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", batch.status().message()));
     dedup_.Record(batch->writer_id, batch->sequence,
                   BatchFingerprint({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1}));
-    Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}};
+    Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}, {}};
     pending.ack = Classify(info_, pending.batch, pending.accept);
     SplitByShard(pending);
     const ScanContext scan(settings_->periods, pending.batch.time);
     for (uint32_t s = 0; s < shards_.size(); ++s) {
       if (shards_[s]->checkpoint_lsn() >= lsn) continue;  // the checkpoint has it already
       shards_[s]->Apply(scan, pending.keys[s], pending.values[s]);
-      std::vector<StateLabel> mine;
-      for (const StateLabel& l : pending.batch.labels) {
-        if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);
-      }
-      shards_[s]->ApplyLabels(mine);
+      shards_[s]->ApplyLabels(pending.labels[s]);
     }
     return absl::OkStatus();
   }, options_.env);
@@ -166,7 +151,7 @@ absl::Status MapStore::Recover() {
 }
 
 MapStore::Pending MapStore::Prepare(ObservationBatch batch, AckCallback done) const {
-  Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}};
+  Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}, {}};
   pending.ack = Classify(info_, pending.batch, pending.accept);
   pending.record.push_back(kBatchRecord);
   pending.record += EncodeBatch(pending.batch);
@@ -178,13 +163,11 @@ MapStore::Pending MapStore::Prepare(ObservationBatch batch, AckCallback done) co
 void MapStore::SplitByShard(Pending& pending) const {
   std::vector<std::vector<uint64_t>>& keys = pending.keys;
   std::vector<std::vector<float>>& values = pending.values;
-  keys.resize(info_.shards);
-  values.resize(info_.shards);
-  for (uint32_t s = 0; s < info_.shards; ++s) {
-    keys[s].clear();
-    values[s].clear();
-  }
+  keys.assign(info_.shards, {});
+  values.assign(info_.shards, {});
+  pending.labels.assign(info_.shards, {});
   const ObservationBatch& b = pending.batch;
+  for (const StateLabel& l : b.labels) pending.labels[ShardOf(l.key, info_.shards)].push_back(l);
   for (size_t i = 0; i < b.keys.size(); ++i) {
     if (!pending.accept[i]) continue;
     const uint32_t s = ShardOf(b.keys[i], info_.shards);
@@ -421,7 +404,7 @@ void MapStore::ApplyLoop() {
     Stage stage;
     {
       std::unique_lock lock(stage_mutex_);
-      if (publication_.has_value() && stages_.empty()) {
+      if (publication_.has_value() && stages_.empty() && !publication_held_) {
         // Publish a slice, then look for batches again: they wait at most one slice.
         lock.unlock();
         ContinuePublication();
@@ -433,6 +416,7 @@ void MapStore::ApplyLoop() {
     }
     stage_changed_.notify_all();
     ApplyGroup(stage.group);
+    if (!stage.group.empty()) publication_held_ = false;
     applied_lsn_ = std::max(applied_lsn_, stage.group_lsn);
     for (Control& c : stage.controls) {
       if (c.kind == Control::Kind::kPublish) {
@@ -475,11 +459,7 @@ void MapStore::ApplyGroup(std::vector<Pending>& group) {
     workers_->RunOnAll([&](uint32_t s) {
       for (size_t b = 0; b < fresh.size(); ++b) {
         shards_[s]->Apply(scans[b], fresh[b]->keys[s], fresh[b]->values[s]);
-        std::vector<StateLabel> mine;
-        for (const StateLabel& l : fresh[b]->batch.labels) {
-          if (ShardOf(l.key, info_.shards) == s) mine.push_back(l);
-        }
-        if (!mine.empty()) shards_[s]->ApplyLabels(mine);
+        if (!fresh[b]->labels[s].empty()) shards_[s]->ApplyLabels(fresh[b]->labels[s]);
       }
     });
   }
@@ -509,6 +489,7 @@ void MapStore::StartPublication(Control control) {
   publication_total_ = 0;
   for (uint64_t n : marked) publication_total_ += n;
   publication_ = std::move(control);
+  publication_held_ = options_.publication_waits_for_a_batch;
   if (publication_->progress) publication_->progress(0, publication_total_);
   if (publication_total_ == 0) FinishPublication();
 }
@@ -561,14 +542,11 @@ absl::Status MapStore::WriteCheckpoint(uint64_t lsn, std::vector<Shard::Checkpoi
   // No backup copies the shards while they change, so that every copy is at one log position.
   std::lock_guard backup(backup_mutex_);
   if (absl::Status error = WriteError(); !error.ok()) return error;  // latched meanwhile: see StartCheckpoint
-  std::vector<std::future<absl::Status>> writes;
-  for (uint32_t s = 0; s < shards_.size(); ++s) {
-    writes.push_back(std::async(std::launch::async, [this, s, &images] { return shards_[s]->WriteCheckpoint(images[s]); }));
-  }
+  std::vector<absl::Status> writes(shards_.size());
+  ParallelForShards(shards_.size(), [&](size_t s) { writes[s] = shards_[s]->WriteCheckpoint(images[s]); });
   absl::Status status;
-  for (auto& w : writes) {
-    const absl::Status r = w.get();
-    if (status.ok()) status = r;
+  for (const absl::Status& w : writes) {
+    if (status.ok()) status = w;
   }
   if (status.ok()) {
     std::lock_guard wal(wal_mutex_);
@@ -606,8 +584,9 @@ absl::Status MapStore::PredictBox(const CellBox& box, double t, const PredictOpt
   }
   const model::PhasorTable table(settings_->periods, t);
   out.assign(box.cell_count(), kUnobservedProbability);
-  ForEachShardInParallel(shards_.size(), box.cell_count() >= (1u << 16),
-                         [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); });
+  ParallelForShards(
+      shards_.size(), [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); },
+      /*parallel=*/box.cell_count() >= (1u << 16));
   return absl::OkStatus();
 }
 
@@ -645,22 +624,7 @@ absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStore::TopN(const std
 MapStats MapStore::Stats() const {
   MapStats stats;
   stats.totals.order_histogram.assign(settings_->max_order + 1, 0);
-  for (const auto& shard : shards_) {
-    const ShardStats s = shard->Stats();
-    stats.totals.states += s.states;
-    stats.totals.dynamic_states += s.dynamic_states;
-    stats.totals.observations += s.observations;
-    stats.totals.disk_bytes += s.disk_bytes;
-    stats.totals.memory_bytes += s.memory_bytes;
-    stats.totals.wide_states += s.wide_states;
-    stats.totals.prediction_error_sum += s.prediction_error_sum;
-    stats.totals.prediction_error_states += s.prediction_error_states;
-    stats.totals.estimation_wrong += s.estimation_wrong;
-    stats.totals.estimation_observed += s.estimation_observed;
-    stats.totals.lossless_prediction_wrong += s.lossless_prediction_wrong;
-    stats.totals.lossless_prediction_observed += s.lossless_prediction_observed;
-    for (size_t l = 0; l < s.order_histogram.size(); ++l) stats.totals.order_histogram[l] += s.order_histogram[l];
-  }
+  for (const auto& shard : shards_) stats.totals += shard->Stats();
   {
     // The committer owns the log; its counters are read racily but only for reporting.
     stats.log_bytes = wal_->bytes();

@@ -73,6 +73,10 @@ struct StoreOptions {
   // LMDB aborts the process on some damaged pages, and a damaged map must fail alone, naming its
   // file, not take the daemon down. Costs one read of the files at open. Default: true.
   bool probe_before_open = true;
+  // Test only: a publication waits before its first slice until a batch has been applied and
+  // acknowledged, so that a test sees batches acknowledged while a publication runs however long
+  // a slice takes against a log sync. Default: false.
+  bool publication_waits_for_a_batch = false;
 };
 
 // Whether `status` is Submit's refusal for a full queue — backpressure: resubmit once OnRoom calls
@@ -176,6 +180,7 @@ class MapStore {
     std::string record;                        // the log record
     std::vector<std::vector<uint64_t>> keys;   // accepted observations by shard
     std::vector<std::vector<float>> values;
+    std::vector<std::vector<StateLabel>> labels;  // the batch's labels by shard
     uint64_t fingerprint = 0;  // BatchFingerprint of the record's batch
   };
   // Requests the committer serves between groups, in order.
@@ -220,7 +225,7 @@ class MapStore {
   void ContinuePublication();
   void FinishPublication();
   absl::StatusOr<uint64_t> RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress = nullptr);
-  // Splits the accepted observations of a batch by shard.
+  // Splits the accepted observations and the labels of a batch by shard.
   void SplitByShard(Pending& pending) const;
   // Classifies, encodes and splits a batch.
   Pending Prepare(ObservationBatch batch, AckCallback done) const;
@@ -246,6 +251,7 @@ class MapStore {
   uint64_t applied_lsn_ = 0;  // applier only
   std::optional<Control> publication_;     // applier only: the publication in progress
   uint64_t publication_total_ = 0;         // applier only: its states
+  bool publication_held_ = false;          // applier only: see StoreOptions::publication_waits_for_a_batch
   std::vector<Control> waiting_checkpoints_;  // applier only: checkpoints asked during a publication
   std::future<void> checkpoint_write_;        // applier only: the image being written, if any
 

@@ -7,7 +7,9 @@
 #include <thread>
 
 #include "storage/env/fault_injection_env.h"
+#include "storage/model/compact_models.h"
 #include "storage/model/phasor.h"
+#include "storage/model/region_predict.h"
 #include "storage/testing/scans.h"
 #include "testing/temp_dir.h"
 
@@ -149,6 +151,50 @@ TEST(MapStoreTest, PredictionsMatchTheModelsAndRegionsMatchPoints) {
   std::vector<float> out;
   EXPECT_TRUE(absl::IsOutOfRange(store->PredictBox({{0, 0, 0}, {41, 1, 1}}, t, {}, out)));
   EXPECT_TRUE(absl::IsOutOfRange(store->PredictBox({{5, 0, 0}, {5, 1, 1}}, t, {}, out)));
+}
+
+// A box query and a point query answer a published state by the region kernel the benchmark measures
+// (model/region_predict.h): bit for bit what the kernel gives for the same models, at each state's
+// own order and at fixed ones.
+TEST(MapStoreTest, PredictionsOfPublishedStatesAreTheRegionKernelsBitForBit) {
+  TempDir dir;
+  const MapInfo map = GridMap("m", 40, 20, 2, 3);
+  auto store = OpenOrDie(map, dir.path());
+  for (uint64_t i = 0; i < 300; ++i) ASSERT_TRUE(store->Write(SweepScan(map, 1, i, 300)).ok());
+  ASSERT_TRUE(store->PublishModels().ok());
+  const int max_order = store->settings().max_order;
+  const CellBox box{{0, 0, 0}, map.grid.size};
+  std::vector<uint64_t> keys;
+  std::vector<size_t> cells;  // index in the box of each published state
+  model::CompactModels models(max_order);
+  for (uint32_t z = 0, i = 0; z < box.hi[2]; ++z) {
+    for (uint32_t y = 0; y < box.hi[1]; ++y) {
+      for (uint32_t x = 0; x < box.hi[0]; ++x, ++i) {
+        const uint64_t key = map.grid.keys().Key(x, y, z);
+        const auto snapshot = store->Snapshot(key);
+        if (!snapshot || snapshot->is_static || !snapshot->model->has_published()) continue;
+        models.Resize(keys.size() + 1);
+        models.Set(keys.size(), snapshot->model->published());
+        keys.push_back(key);
+        cells.push_back(i);
+      }
+    }
+  }
+  ASSERT_GT(keys.size(), 100u);
+  const double t = 1.7e9 + 300 * 600.0 + 5000;
+  const model::PhasorTable table(store->settings().periods, t);
+  std::vector<float> kernel(keys.size()), region;
+  for (int order = -1; order <= max_order + 1; ++order) {
+    PredictOptions options;
+    options.order = order;
+    model::PredictRegion(models, table, order, kernel.data());
+    ASSERT_TRUE(store->PredictBox(box, t, options, region).ok());
+    const std::vector<float> points = store->Predict(keys, {&t, 1}, options);
+    for (size_t j = 0; j < keys.size(); ++j) {
+      ASSERT_EQ(region[cells[j]], kernel[j]) << "cell " << cells[j] << " order " << order;
+      ASSERT_EQ(points[j], kernel[j]) << "cell " << cells[j] << " order " << order;
+    }
+  }
 }
 
 TEST(MapStoreTest, GrowsATinyLmdbMapInsteadOfFailing) {

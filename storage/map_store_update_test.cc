@@ -7,8 +7,9 @@
 
 #include <algorithm>
 #include <atomic>
-#include <filesystem>
 #include <chrono>
+#include <filesystem>
+#include <future>
 #include <thread>
 
 #include "storage/map_store.h"
@@ -125,7 +126,9 @@ TEST(MapStoreUpdateTest, TouchedStatesSurviveCheckpointsAndRestarts) {
 
 // Ingest and queries during a publication: batches are acknowledged while it runs, a reader sees
 // each state's old or new prediction and never anything else, and the interleaved result equals
-// the recovery's replay of the log (where the publication is one record among the batches).
+// the recovery's replay of the log (where the publication is one record among the batches). The
+// publication waits for a batch before its first slice (StoreOptions::publication_waits_for_a_batch),
+// so that a batch is acknowledged during it however long a slice takes against a log sync.
 TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsItsReplay) {
   TempDir dir, image;
 #if defined(__SANITIZE_THREAD__)
@@ -134,9 +137,10 @@ TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsIts
   constexpr uint32_t kNz = 8;  // 524,288 dynamic states: many slices
 #endif
   const MapInfo map = GridMap("m", 256, 256, kNz, 2);
-  StoreOptions no_checkpoint;  // the log holds everything, so a copy is a crash image to replay
-  no_checkpoint.checkpoint_log_bytes = UINT64_MAX;
-  auto store = OpenOrDie(map, dir.path(), no_checkpoint);
+  StoreOptions options;
+  options.checkpoint_log_bytes = UINT64_MAX;  // the log holds everything, so a copy is a crash image to replay
+  options.publication_waits_for_a_batch = true;
+  auto store = OpenOrDie(map, dir.path(), options);
   for (uint64_t i = 0; i < 3; ++i) ASSERT_TRUE(store->Write(Planes(map, 1, i, 0, kNz, kT0 + 3600.0 * i)).ok());
 
   // The reader's cells (rows y ≥ 128) get no new observations, so each has exactly two possible
@@ -150,21 +154,36 @@ TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsIts
   }
   const std::vector<float> before = store->Predict(watched, {&t, 1}, {});
 
-  std::atomic<bool> publishing = true, started = false;
+  // The publication's progress and every acknowledgement are called on the map's applier thread,
+  // one after another: an acknowledgement between the first progress call (0 done) and the last
+  // (all done) came while the publication ran.
+  std::atomic<bool> publication_started = false, publication_finished = false;
+  const auto progress = [&](uint64_t done, uint64_t total) {
+    publication_started = true;
+    if (done == total) publication_finished = true;
+  };
+  std::atomic<bool> publishing = true;
   std::atomic<uint64_t> acked = 0, acked_during = 0, torn = 0, reads = 0;
   absl::Status write_failure;  // the writer's error, read once it has been joined
   std::atomic<bool> write_failed = false;
   std::thread writer([&] {
     // Rows y < 128 keep being observed; they include states the publication has not reached yet.
     for (uint64_t i = 3; publishing; ++i) {
-      auto ack = store->Write(Planes(map, 2, i, 0, kNz, kT0 + 3600.0 * i, 128));
-      if (!ack.ok()) {
-        write_failure = ack.status();
+      std::promise<absl::StatusOr<BatchAck>> answer;
+      const absl::Status submitted =
+          store->Submit(Planes(map, 2, i, 0, kNz, kT0 + 3600.0 * i, 128), [&](absl::StatusOr<BatchAck> ack) {
+            if (ack.ok() && publication_started && !publication_finished) ++acked_during;
+            answer.set_value(std::move(ack));
+          });
+      const absl::StatusOr<BatchAck> ack = submitted.ok() ? answer.get_future().get() : submitted;
+      if (!ack.ok() || !ack->error.ok()) {
+        write_failure = ack.ok() ? ack->error : ack.status();
         write_failed = true;
+        // A held publication waits for a batch that will not come now: closing finishes it.
+        (void)store->Close();
         break;
       }
       ++acked;
-      if (started && publishing) ++acked_during;
     }
   });
   std::vector<std::vector<float>> seen;
@@ -175,14 +194,14 @@ TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsIts
     }
   });
   // Both are under way before the publication starts (a loaded machine may be slow to start a
-  // thread or to sync the log's first batch), so that the figures below measure the publication.
+  // thread or to sync the log's first batch), so that the reads below cover the publication.
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(2);
   while ((acked == 0 || reads == 0) && !write_failed && std::chrono::steady_clock::now() < give_up) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   const bool under_way = acked > 0 && reads > 0;
-  started = true;
-  auto published = under_way ? store->PublishModels() : absl::StatusOr<uint64_t>(absl::AbortedError("not run"));
+  auto published =
+      under_way && !write_failed ? store->PublishModels(progress) : absl::StatusOr<uint64_t>(absl::AbortedError("not run"));
   publishing = false;
   writer.join();
   reader.join();
@@ -190,6 +209,7 @@ TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsIts
   ASSERT_TRUE(under_way) << "the writer or the reader did not start within 2 minutes";
   ASSERT_TRUE(published.ok()) << published.status();
   EXPECT_EQ(*published, 256u * 256 * kNz);
+  EXPECT_TRUE(publication_finished);
   const std::vector<float> after = store->Predict(watched, {&t, 1}, {});
   for (const std::vector<float>& read : seen) {
     for (size_t j = 0; j < watched.size(); ++j) {
@@ -202,7 +222,7 @@ TEST(MapStoreUpdateTest, IngestAndQueriesContinueDuringAPublicationThatEqualsIts
 
   std::filesystem::copy(dir.path(), image.path(), std::filesystem::copy_options::recursive |
                                                       std::filesystem::copy_options::overwrite_existing);
-  auto replayed = OpenOrDie(map, image.path(), no_checkpoint);
+  auto replayed = OpenOrDie(map, image.path(), options);
   EXPECT_TRUE(Models(*replayed, map) == Models(*store, map)) << "the replay differs from the live publication";
 }
 

@@ -88,8 +88,7 @@ bool SendFrame(int fd, Tag tag, std::string_view a = {}, std::string_view b = {}
   PutString(body, a);
   PutString(body, b);
   std::string frame(4, '\0');
-  const uint32_t n = static_cast<uint32_t>(body.size());
-  for (int i = 0; i < 4; ++i) frame[i] = static_cast<char>(n >> (8 * i));
+  model::EncodeFixed32(frame.data(), static_cast<uint32_t>(body.size()));
   frame += body;
   return WriteAll(fd, frame);
 }
@@ -250,9 +249,7 @@ class ShardSalvager {
                               buffer.append(chunk);
                               size_t pos = 0;
                               while (buffer.size() - pos >= 4) {
-                                uint32_t n = 0;
-                                for (int i = 0; i < 4; ++i)
-                                  n |= uint32_t{static_cast<uint8_t>(buffer[pos + i])} << (8 * i);
+                                const uint32_t n = model::DecodeFixed32(buffer.data() + pos);
                                 if (buffer.size() - pos - 4 < n) break;
                                 on_frame(std::string_view(buffer).substr(pos + 4, n));
                                 pos += 4 + n;

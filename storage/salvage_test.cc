@@ -36,8 +36,6 @@ using testing::Record;
 using testing::ShardRecords;
 using fremen::testing::TempDir;
 
-std::string MapDir(const TempDir& dir, uint64_t id) { return dir.path() + "/maps/" + std::to_string(id); }
-
 const SalvageDatabase& Db(const SalvageReport& report, const std::string& name) {
   for (const SalvageDatabase& d : report.shards.at(0).databases) {
     if (d.name == name) return d;
@@ -87,7 +85,7 @@ TEST(SalvageTest, AFlippedBitLosesThatRecordAndKeepsEveryOther) {
   std::map<uint64_t, std::string> want;
   const MapInfo info = FilledMap(dir, want);
   ASSERT_EQ(want.size(), kStates);
-  const std::string shard_dir = MapDir(dir, info.id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::string shard_dir = MapDirIn(dir.path(), info.id) + "/shard-0", file = shard_dir + "/data.mdb";
   const std::vector<Record> dynamic = RecordsOf(shard_dir, "dynamic");
   const size_t statics = RecordsOf(shard_dir, "static").size();
   ASSERT_EQ(dynamic.size(), kStates - kStates / 4);
@@ -160,7 +158,7 @@ TEST(SalvageTest, AnLmdbAbortKeepsTheRecordsReadBeforeItAndTheOtherDatabases) {
   TempDir dir;
   std::map<uint64_t, std::string> want;
   const MapInfo info = FilledMap(dir, want);
-  const std::string shard_dir = MapDir(dir, info.id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::string shard_dir = MapDirIn(dir.path(), info.id) + "/shard-0", file = shard_dir + "/data.mdb";
   const std::vector<Record> dynamic = RecordsOf(shard_dir, "dynamic");
   const size_t statics = RecordsOf(shard_dir, "static").size();
   for (const size_t at : testing::FindAll(testing::ReadWholeFile(file), Bytes(dynamic[dynamic.size() / 2].value))) {
@@ -216,7 +214,7 @@ TEST(SalvageTest, AStateStoredBothAsNeverChangedAndChangedKeepsItsChangedModel) 
   TempDir dir;
   std::map<uint64_t, std::string> want;
   const MapInfo info = FilledMap(dir, want);
-  const std::string shard_dir = MapDir(dir, info.id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::string shard_dir = MapDirIn(dir.path(), info.id) + "/shard-0", file = shard_dir + "/data.mdb";
   const std::vector<Record> dynamic = RecordsOf(shard_dir, "dynamic");
   const size_t statics = RecordsOf(shard_dir, "static").size();
   {
@@ -305,7 +303,7 @@ TEST(SalvageTest, ALosslessHistoryWhoseStateWasLostIsDroppedAndReported) {
     }
     for (uint64_t k = 1; k <= kKeys; ++k) want[k] = *map->Snapshot(k);
   }
-  const std::string shard_dir = MapDir(dir, info.id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::string shard_dir = MapDirIn(dir.path(), info.id) + "/shard-0", file = shard_dir + "/data.mdb";
   const std::vector<Record> dynamic = RecordsOf(shard_dir, "dynamic");
   ASSERT_EQ(dynamic.size(), kKeys);
   ASSERT_EQ(RecordsOf(shard_dir, "lossless").size(), kKeys);
@@ -411,7 +409,7 @@ uint64_t DamageLogRecord(const std::string& segment, uint64_t lsn) {
 TEST(SalvageTest, ACorruptLogRecordKeepsTheLogBeforeItAndReportsTheRest) {
   TempDir dir, image;
   const uint64_t id = CrashedAfterCheckpoint(dir, image, 1, 20, 8).id;  // LSNs 25..44 in the log only
-  const std::string segment = OnlySegment(MapDir(image, id) + "/wal");
+  const std::string segment = OnlySegment(MapDirIn(image.path(), id) + "/wal");
   const std::string log = testing::ReadWholeFile(segment);
   const uint64_t at = DamageLogRecord(segment, 35);
 
@@ -455,7 +453,7 @@ TEST(SalvageTest, ACorruptLogRecordKeepsTheLogBeforeItAndReportsTheRest) {
 TEST(SalvageTest, ALostCheckpointLsnAppliesNoLogRecordToItsShardTwice) {
   TempDir dir, image;
   const MapInfo info = CrashedAfterCheckpoint(dir, image, 2, 10, kStates);  // LSNs 25..34 in the log only
-  const std::string file = MapDir(image, info.id) + "/shard-1/data.mdb";
+  const std::string file = MapDirIn(image.path(), info.id) + "/shard-1/data.mdb";
   const std::string key = shard_records::kLsnKey;
   const std::vector<size_t> copies = testing::FindAll(testing::ReadWholeFile(file), Bytes(key));
   ASSERT_FALSE(copies.empty());
@@ -494,7 +492,7 @@ TEST(SalvageTest, ALostCheckpointLsnAppliesNoLogRecordToItsShardTwice) {
 TEST(SalvageTest, ASalvageThatCannotWriteLeavesNothingBehind) {
   TempDir dir, image;
   const uint64_t id = CrashedAfterCheckpoint(dir, image, 1, 20, 8).id;
-  DamageLogRecord(OnlySegment(MapDir(image, id) + "/wal"), 35);
+  DamageLogRecord(OnlySegment(MapDirIn(image.path(), id) + "/wal"), 35);
   FaultInjectionEnv env;
   StoreOptions options;
   options.env = &env;
@@ -511,7 +509,7 @@ TEST(SalvageTest, ASalvageThatCannotWriteLeavesNothingBehind) {
   EXPECT_TRUE(absl::IsNotFound((*store)->Map("m-salvaged").status()));
   std::vector<std::string> dirs;
   for (const auto& e : std::filesystem::directory_iterator(image.path() + "/maps")) dirs.push_back(e.path().string());
-  EXPECT_EQ(dirs, std::vector<std::string>{MapDir(image, id)});
+  EXPECT_EQ(dirs, std::vector<std::string>{MapDirIn(image.path(), id)});
   ASSERT_EQ((*store)->FailedMaps().size(), 1u);
   env.FailWrites(0);
   auto report = (*store)->SalvageMap("m", "");

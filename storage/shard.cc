@@ -7,6 +7,7 @@
 #include "storage/cell_key.h"
 #include "storage/model/publication.h"
 #include "storage/model/record_codec.h"
+#include "storage/model/region_predict.h"
 #include "storage/model/scan_update.h"
 #include "storage/shard_records.h"
 #include "storage/static_bricks.h"
@@ -240,36 +241,38 @@ void Shard::ApplyLabels(std::span<const StateLabel> labels) {
   }
 }
 
-float Shard::PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f,
-                           const float* sin_f, const PredictOptions& options) const {
+float Shard::PredictHandle(uint32_t handle, const model::PhasorTable& table, const PredictOptions& options) const {
   if (handle == kNone) return kUnobservedProbability;
   if (handle & kStaticHandle) return static_cast<float>(handle & 1u);  // persistence agrees: s(t_l) = value
   const uint32_t d = handle;
-  const model::CompactModelHeader& h = models_.header(d);
   float p;
-  if (!h.published) {
-    const model::SpectrumHeader& sh = spectra_.header(d);
-    p = sh.n > 0 ? static_cast<float>(sh.sum_s / sh.n) : kUnobservedProbability;
-  } else {
-    const int order = std::min(options.order < 0 ? static_cast<int>(h.order) : options.order, settings_.max_order);
-    const uint16_t* k = models_.k(d);
-    const float* a = models_.a(d);
-    const float* b = models_.b(d);
-    p = h.alpha0;
-    for (int j = 0; j < order; ++j) p += a[j] * cos_f[k[j]] - b[j] * sin_f[k[j]];
-    p = std::clamp(p, 0.0f, 1.0f);
+  if (models_.published(d)) {
+    PredictPublished({&d, 1}, table, options, &p);
+    return p;
   }
+  const model::SpectrumHeader& sh = spectra_.header(d);
+  p = sh.n > 0 ? static_cast<float>(sh.sum_s / sh.n) : kUnobservedProbability;
   if (options.persistence && settings_.persistence) {
     p = static_cast<float>(persistence_[d].Predict(table.time(), p));
   }
   return p;
 }
 
+void Shard::PredictPublished(std::span<const uint32_t> dynamic, const model::PhasorTable& table,
+                             const PredictOptions& options, float* out) const {
+  model::PredictRecords(models_, dynamic, table, options.order, out);
+  if (options.persistence && settings_.persistence) {
+    for (size_t i = 0; i < dynamic.size(); ++i) {
+      out[i] = static_cast<float>(persistence_[dynamic[i]].Predict(table.time(), out[i]));
+    }
+  }
+}
+
 float Shard::Predict(uint64_t key, const model::PhasorTable& table, const PredictOptions& options) const {
   std::shared_lock lock(mutex_);
   const auto it = bricks_.find(BrickOf(key));
   if (it == bricks_.end()) return kUnobservedProbability;
-  return PredictHandle(brick_data_[it->second].handles[key & 511], table, table.cos_f(), table.sin_f(), options);
+  return PredictHandle(brick_data_[it->second].handles[key & 511], table, options);
 }
 
 void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
@@ -277,8 +280,6 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   if (box.cell_count() == 0) return;
   std::shared_lock lock(mutex_);
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
-  const float* cos_f = table.cos_f();
-  const float* sin_f = table.sin_f();
   const std::array<uint32_t, 3> bs = grid_keys_.brick_size();
   // A cell's index in its brick is its key's low 9 bits: the sum of each axis' bits, spread —
   // three lookups per cell instead of a Morton encoding.
@@ -289,7 +290,12 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
     if (i < bs[1]) spread_y[i] = grid_keys_.LocalIndex(0, i, 0);
     if (i < bs[2]) spread_z[i] = grid_keys_.LocalIndex(0, 0, i);
   }
-  // Brick by brick: one hash lookup per brick, then the cells of the box inside it.
+  // Brick by brick: one hash lookup per brick, then the cells of the box inside it. The cells whose
+  // state has a published model — nearly all, on a map in use — go through the region kernel
+  // together, a brick at a time; the others are answered one by one.
+  std::array<uint32_t, 512> published;
+  std::array<float*, 512> published_cells;
+  std::array<float, 512> predicted;
   for (uint32_t bz = box.lo[2] / bs[2]; bz <= (box.hi[2] - 1) / bs[2]; ++bz) {
     for (uint32_t by = box.lo[1] / bs[1]; by <= (box.hi[1] - 1) / bs[1]; ++by) {
       for (uint32_t bx = box.lo[0] / bs[0]; bx <= (box.hi[0] - 1) / bs[0]; ++bx) {
@@ -299,16 +305,25 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
         const uint32_t z0 = std::max(box.lo[2], bz * bs[2]), z1 = std::min(box.hi[2], (bz + 1) * bs[2]);
         const uint32_t y0 = std::max(box.lo[1], by * bs[1]), y1 = std::min(box.hi[1], (by + 1) * bs[1]);
         const uint32_t x0 = std::max(box.lo[0], bx * bs[0]), x1 = std::min(box.hi[0], (bx + 1) * bs[0]);
+        size_t n = 0;
         for (uint32_t z = z0; z < z1; ++z) {
           for (uint32_t y = y0; y < y1; ++y) {
             float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
             const uint32_t yz = spread_y[y & (bs[1] - 1)] | spread_z[z & (bs[2] - 1)];
             for (uint32_t x = x0; x < x1; ++x) {
               const uint32_t handle = brick.handles[yz | spread_x[x & mask_x]];
-              if (handle != kNone) row[x] = PredictHandle(handle, table, cos_f, sin_f, options);
+              if (handle == kNone) continue;
+              if (!(handle & kStaticHandle) && models_.published(handle)) {
+                published[n] = handle;
+                published_cells[n++] = &row[x];
+              } else {
+                row[x] = PredictHandle(handle, table, options);
+              }
             }
           }
         }
+        PredictPublished({published.data(), n}, table, options, predicted.data());
+        for (size_t i = 0; i < n; ++i) *published_cells[i] = predicted[i];
       }
     }
   }

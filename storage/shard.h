@@ -53,6 +53,7 @@
 #include "storage/model/state_model.h"
 #include "storage/model/static_state.h"
 #include "storage/model/wide_bodies.h"
+#include "storage/shard_stats.h"
 
 namespace fremen::storage {
 
@@ -82,22 +83,6 @@ struct StateSnapshot {
   std::optional<model::CompactStateModel> model;  // when dynamic
   std::optional<model::LosslessHistory> lossless;
   std::string name, group;
-};
-
-struct ShardStats {
-  uint64_t states = 0;
-  uint64_t dynamic_states = 0;
-  uint64_t observations = 0;  // Σ n over states
-  uint64_t disk_bytes = 0;
-  uint64_t memory_bytes = 0;
-  uint64_t wide_states = 0;  // dynamic states whose spectrum is folded in double (model/wide_bodies.h)
-  std::vector<uint64_t> order_histogram;  // selected order of dynamic published states, 0..L
-  double prediction_error_sum = 0;        // Σ ε_p(selected order) over dynamic states with evidence
-  uint64_t prediction_error_states = 0;
-  // Lossless maps (eq. 15 from the outlier sets): wrong and observed slots, over all history (ε_e)
-  // and since the last update (ε_p).
-  uint64_t estimation_wrong = 0, estimation_observed = 0;
-  uint64_t lossless_prediction_wrong = 0, lossless_prediction_observed = 0;
 };
 
 // The value an unobserved state predicts: no information either way.
@@ -209,8 +194,12 @@ class Shard {
   void ObserveBesidesSpectrum(uint32_t d, double t, float value);
   uint32_t AddDynamic(uint32_t slot);
   void MarkDirty(uint32_t slot);
-  float PredictHandle(uint32_t handle, const model::PhasorTable& table, const float* cos_f, const float* sin_f,
-                      const PredictOptions& options) const;
+  // p(t) of the state behind a handle (see kStaticHandle).
+  float PredictHandle(uint32_t handle, const model::PhasorTable& table, const PredictOptions& options) const;
+  // out[i] = p(t) of dynamic state dynamic[i], each with a published model: the region kernel
+  // (model/region_predict.h, what the benchmark measures), then persistence when asked for.
+  void PredictPublished(std::span<const uint32_t> dynamic, const model::PhasorTable& table,
+                        const PredictOptions& options, float* out) const;
   // Publishes one dynamic state (see BeginPublication) and clears its flags; `history_updated`:
   // the caller has updated its lossless history already (outside the lock). REQUIRES: mutex_ held
   // exclusively.

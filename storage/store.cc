@@ -105,7 +105,7 @@ std::vector<std::string> Store::UnknownDirectories() const { return unknown_dirs
 
 Store::~Store() { (void)Close(); }
 
-std::string Store::MapDir(uint64_t id) const { return absl::StrCat(data_dir_, "/maps/", id); }
+std::string Store::MapDir(uint64_t id) const { return MapDirIn(data_dir_, id); }
 
 bool Store::HasDirectory(uint64_t id) const {
   std::error_code error;

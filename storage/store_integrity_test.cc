@@ -32,8 +32,6 @@ using testing::Record;
 using testing::ShardRecords;
 using fremen::testing::TempDir;
 
-std::string MapDir(const TempDir& dir, uint64_t id) { return dir.path() + "/maps/" + std::to_string(id); }
-
 // Before record checksums, 3 of 1,024 models came back with a different spectrum and no error after single-bit flips in
 // shard records. Now every flip of a bit of a record (value or checksum) is found: the map fails with DataLoss naming
 // its file and the record's key; no model is served from damaged bytes.
@@ -52,7 +50,7 @@ TEST(StoreIntegrityTest, SingleBitFlipsInShardRecordsAreDataLossNeverAnotherMode
     want = Fingerprints(*map);
   }
   ASSERT_EQ(want.size(), kStates);
-  const std::string shard_dir = MapDir(dir, id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::string shard_dir = MapDirIn(dir.path(), id) + "/shard-0", file = shard_dir + "/data.mdb";
   {
     // Undamaged, the map comes back whole.
     auto store = Store::Open(dir.path(), {});
@@ -133,7 +131,7 @@ TEST(StoreIntegrityTest, ACatalogBitFlipDeletesNothingAndIsReported) {
   ASSERT_FALSE(copies.empty());
   // version | name length | "alpha" | id: the id's lowest bit (the flip that used to change a map's id).
   for (const size_t at : copies) testing::FlipBit(catalog, at + 2 + alpha.name.size(), 0);
-  const std::string alpha_dir = MapDir(dir, alpha.id);
+  const std::string alpha_dir = MapDirIn(dir.path(), alpha.id);
   const std::string shard_file = alpha_dir + "/shard-0/data.mdb";
   const std::string before = testing::ReadWholeFile(shard_file);
 
@@ -183,7 +181,7 @@ TEST(StoreIntegrityTest, AZeroedShardPageFailsThatMapAloneNamingTheFile) {
     Fill(**(*store)->Map("bad"));
     good_models = Fingerprints(**(*store)->Map("good"));
   }
-  const std::string shard_dir = MapDir(dir, bad_id) + "/shard-0", file = shard_dir + "/data.mdb";
+  const std::string shard_dir = MapDirIn(dir.path(), bad_id) + "/shard-0", file = shard_dir + "/data.mdb";
   // Zero a leaf page holding dynamic records, in the middle of the file.
   std::vector<Record> dynamic;
   for (Record& r : ShardRecords(shard_dir)) {
@@ -216,7 +214,7 @@ TEST(StoreIntegrityTest, AZeroedShardPageFailsThatMapAloneNamingTheFile) {
   ASSERT_EQ(failed.size(), 1u);
   EXPECT_EQ(failed[0].name, "bad");
   EXPECT_EQ(failed[0].id, bad_id);
-  EXPECT_EQ(failed[0].dir, MapDir(dir, bad_id));
+  EXPECT_EQ(failed[0].dir, MapDirIn(dir.path(), bad_id));
   // Still in the catalog: listed, with its info.
   EXPECT_TRUE((*store)->GetMap("bad").ok());
   EXPECT_TRUE((*store)->UnknownDirectories().empty());
@@ -231,7 +229,7 @@ TEST(StoreIntegrityTest, AZeroedShardPageFailsThatMapAloneNamingTheFile) {
   EXPECT_TRUE((*good)->Write(b).ok());
   // An operator may delete the failed map deliberately: then, and only then, its files go.
   ASSERT_TRUE((*store)->DeleteMap("bad").ok());
-  EXPECT_FALSE(std::filesystem::exists(MapDir(dir, bad_id)));
+  EXPECT_FALSE(std::filesystem::exists(MapDirIn(dir.path(), bad_id)));
   EXPECT_TRUE((*store)->FailedMaps().empty());
   EXPECT_TRUE(absl::IsNotFound((*store)->Map("bad").status()));
 }

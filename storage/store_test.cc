@@ -39,7 +39,7 @@ TEST(StoreTest, MapsLiveAcrossRestartsAndDeleteRemovesTheirFiles) {
   auto a = (*store)->Map("a");
   ASSERT_TRUE(a.ok());
   EXPECT_EQ((*a)->Stats().totals.observations, 20u * 50);
-  const std::string a_dir = dir.path() + "/maps/" + std::to_string((*a)->info().id);
+  const std::string a_dir = MapDirIn(dir.path(), (*a)->info().id);
   EXPECT_TRUE(std::filesystem::exists(a_dir));
   a->reset();
   ASSERT_TRUE((*store)->DeleteMap("a").ok());

@@ -1,7 +1,5 @@
 #include "storage/update_record.h"
 
-#include <cstring>
-
 #include "absl/strings/str_cat.h"
 #include "storage/model/varint.h"
 
@@ -13,21 +11,15 @@ constexpr uint8_t kVersion = 1;
 // Orders 0..L with L ≤ 64: a longer histogram is corruption.
 constexpr uint64_t kMaxHistogram = 65;
 
-void PutDouble(std::string* out, double v) {
-  uint64_t bits;
-  std::memcpy(&bits, &v, 8);
-  for (int i = 0; i < 8; ++i) out->push_back(static_cast<char>(bits >> (8 * i)));
-}
-
 }  // namespace
 
 std::string EncodeUpdateRecord(const UpdateRecord& r) {
   std::string out(1, static_cast<char>(kVersion));
-  PutDouble(&out, r.start_time);
-  PutDouble(&out, r.duration_seconds);
+  model::PutDouble(&out, r.start_time);
+  model::PutDouble(&out, r.duration_seconds);
   model::PutVarint64(&out, r.states_updated);
-  PutDouble(&out, r.prediction_error_before);
-  PutDouble(&out, r.prediction_error_after);
+  model::PutDouble(&out, r.prediction_error_before);
+  model::PutDouble(&out, r.prediction_error_after);
   model::PutVarint64(&out, r.order_histogram.size());
   for (uint64_t n : r.order_histogram) model::PutVarint64(&out, n);
   return out;

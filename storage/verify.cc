@@ -570,7 +570,7 @@ DataDirVerifyReport VerifyDataDir(const std::string& data_dir, const VerifyOptio
     closedir(d);
   }
   for (const MapInfo& info : maps) {
-    const std::string dir = absl::StrCat(data_dir, "/maps/", info.id);
+    const std::string dir = MapDirIn(data_dir, info.id);
     struct stat st;
     if (stat(dir.c_str(), &st) != 0) {
       report.problems.push_back(

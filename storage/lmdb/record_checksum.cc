@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "storage/model/varint.h"
 
 namespace fremen::storage {
 
@@ -27,10 +28,12 @@ uint32_t RecordChecksum(std::span<const uint8_t> key, std::span<const uint8_t> v
   return Crc(Crc(crc32(0L, Z_NULL, 0), key), value);
 }
 
+static_assert(kRecordChecksumBytes == 4, "the checksum is stored as a little-endian fixed32");
+
 void EncodeChecked(std::span<const uint8_t> key, std::span<const uint8_t> value, uint8_t* out) {
   if (!value.empty()) std::memcpy(out, value.data(), value.size());
   const uint32_t crc = RecordChecksum(key, value);
-  for (size_t i = 0; i < kRecordChecksumBytes; ++i) out[value.size() + i] = static_cast<uint8_t>(crc >> (8 * i));
+  model::EncodeFixed32(out + value.size(), crc);
 }
 
 absl::StatusOr<std::span<const uint8_t>> CheckRecord(std::span<const uint8_t> key, std::span<const uint8_t> stored) {
@@ -39,8 +42,7 @@ absl::StatusOr<std::span<const uint8_t>> CheckRecord(std::span<const uint8_t> ke
                                             kRecordChecksumBytes, "-byte checksum"));
   }
   const std::span<const uint8_t> value = stored.first(stored.size() - kRecordChecksumBytes);
-  uint32_t expected = 0;
-  for (size_t i = 0; i < kRecordChecksumBytes; ++i) expected |= uint32_t{stored[value.size() + i]} << (8 * i);
+  const uint32_t expected = model::DecodeFixed32(stored.data() + value.size());
   if (const uint32_t actual = RecordChecksum(key, value); actual != expected) {
     return absl::DataLossError(absl::StrCat("checksum mismatch (stored ", absl::Hex(expected, absl::kZeroPad8),
                                             ", computed ", absl::Hex(actual, absl::kZeroPad8), ")"));

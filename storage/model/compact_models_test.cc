@@ -96,6 +96,23 @@ TEST(CompactModelsTest, PredictRegionOfASubrange) {
   for (size_t i = 0; i < part.size(); ++i) EXPECT_EQ(part[i], all[40 + i]);
 }
 
+// The listed form (what a shard's box query runs) is the same kernel: bit for bit the prediction of
+// PredictRegion for each listed record, in any order and with repeats, at every order.
+TEST(CompactModelsTest, PredictRecordsEqualsPredictRegionOfEachRecord) {
+  const Fixture f(700);
+  std::vector<uint32_t> records;
+  std::mt19937_64 rng(5);
+  for (size_t i = 0; i < 600; ++i) records.push_back(static_cast<uint32_t>(rng() % f.published.size()));
+  const PhasorTable table(f.periods, 1.7e9 + 2468);
+  std::vector<float> all(f.published.size()), listed(records.size());
+  for (int order = -1; order <= kL + 1; ++order) {
+    PredictRegion(f.models, table, order, all.data());
+    PredictRecords(f.models, records, table, order, listed.data());
+    for (size_t i = 0; i < records.size(); ++i) ASSERT_EQ(listed[i], all[records[i]]) << i << " order " << order;
+  }
+  PredictRecords(f.models, {}, table, -1, nullptr);  // nothing listed: nothing read or written
+}
+
 TEST(CompactModelsTest, HigherMaxOrdersUseTheGenericKernel) {
   const PeriodSet periods = PeriodSet::Default();
   constexpr int kBigL = 12;

@@ -261,6 +261,28 @@ void BM_PredictU8(benchmark::State& state) {
 }
 BENCHMARK(BM_PredictU8)->Arg(2)->Arg(5)->Arg(-1)->Unit(benchmark::kMicrosecond);
 
+// The listed form a shard's box query runs, a brick (512 records) at a time; range(1) = 1: the records
+// shuffled within each brick, the worst case of a box whose states were promoted in no spatial order
+// (memory-bound: each record is a cache miss the prefetcher cannot foresee), 0: in order.
+void BM_PredictListed(benchmark::State& state) {
+  const bool shuffled = state.range(1) != 0;
+  std::vector<uint32_t> records(Models().size());
+  for (size_t i = 0; i < records.size(); ++i) records[i] = static_cast<uint32_t>(i);
+  std::mt19937_64 rng(3);
+  for (size_t b = 0; shuffled && b < records.size(); b += 512) {
+    std::shuffle(records.begin() + b, records.begin() + std::min(records.size(), b + 512), rng);
+  }
+  RunPredictions<float>(state, [&](const CompactModels& m, const PhasorTable& p, int order, float* out) {
+    for (size_t b = 0; b < records.size(); b += 512) {
+      PredictRecords(m, std::span(records).subspan(b, std::min<size_t>(512, records.size() - b)), p, order, out + b);
+    }
+  });
+  const int order = static_cast<int>(state.range(0));
+  state.SetLabel((order < 0 ? std::string("own orders, mixed 0..5") : "l = " + std::to_string(order)) +
+                 (shuffled ? ", shuffled in bricks" : ", in order"));
+}
+BENCHMARK(BM_PredictListed)->ArgsProduct({{2, 5, -1}, {0, 1}})->Unit(benchmark::kMicrosecond);
+
 // Order choice + top-L publication of kScanCells states (errors choose orders 0..5 at random).
 void BM_Publish(benchmark::State& state) {
   const RecordArena& arena = BigArena();

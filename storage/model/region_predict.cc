@@ -35,20 +35,32 @@ constexpr auto kOrderMask = [] {
   return mask;
 }();
 
+// Where the records of a query lie: consecutive from `first` (a region of the table), or at the
+// listed indices (a box of cells, whose states sit where they were first observed).
+struct Consecutive {
+  size_t first;
+  size_t operator[](size_t i) const { return first + i; }
+};
+struct Listed {
+  const uint32_t* records;
+  size_t operator[](size_t i) const { return records[i]; }
+};
+
 // kTerms components per record (kRuntime: `terms`). With kOwnOrder, kTerms is L and each record keeps
 // only its first `order` terms: by masking rather than by a loop bound, because a trip count that
 // changes from cell to cell mispredicts a branch per cell (measured 2x slower with mixed orders).
-template <int kTerms, bool kOwnOrder, typename Out>
-void PredictRange(const CompactModels& models, size_t first, size_t count, const float* cos_t, const float* sin_t,
+template <int kTerms, bool kOwnOrder, typename Records, typename Out>
+void PredictRange(const CompactModels& models, Records records, size_t count, const float* cos_t, const float* sin_t,
                   int terms, Out* out) {
   const size_t stride = models.stride();
   const size_t a_offset = models.a_offset(), b_offset = models.b_offset();
   const int n_terms = kTerms == kRuntime ? terms : kTerms;
-  const std::byte* r = count > 0 ? models.record(first) : nullptr;
+  const std::byte* base = count > 0 ? models.record(0) : nullptr;
   float raw[kBlock];
   for (size_t start = 0; start < count; start += kBlock) {
     const size_t n = std::min(kBlock, count - start);
-    for (size_t i = 0; i < n; ++i, r += stride) {
+    for (size_t i = 0; i < n; ++i) {
+      const std::byte* r = base + records[start + i] * stride;
       const auto* h = reinterpret_cast<const CompactModelHeader*>(r);
       const auto* k = reinterpret_cast<const uint16_t*>(r + CompactModels::kKOffset);
       const auto* a = reinterpret_cast<const float*>(r + a_offset);
@@ -68,35 +80,41 @@ void PredictRange(const CompactModels& models, size_t first, size_t count, const
 }
 
 // PredictRange<terms, kOwnOrder>, unrolled when terms <= kUnrolledOrders.
-template <bool kOwnOrder, int kTerms = 0, typename Out>
-void Dispatch(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int terms,
+template <bool kOwnOrder, int kTerms = 0, typename Records, typename Out>
+void Dispatch(const CompactModels& models, Records records, size_t count, const PhasorTable& phasors, int terms,
               Out* out) {
   if constexpr (kTerms > kUnrolledOrders) {
-    PredictRange<kRuntime, kOwnOrder>(models, first, count, phasors.cos_f(), phasors.sin_f(), terms, out);
+    PredictRange<kRuntime, kOwnOrder>(models, records, count, phasors.cos_f(), phasors.sin_f(), terms, out);
   } else if (terms == kTerms) {
-    PredictRange<kTerms, kOwnOrder>(models, first, count, phasors.cos_f(), phasors.sin_f(), terms, out);
+    PredictRange<kTerms, kOwnOrder>(models, records, count, phasors.cos_f(), phasors.sin_f(), terms, out);
   } else {
-    Dispatch<kOwnOrder, kTerms + 1>(models, first, count, phasors, terms, out);
+    Dispatch<kOwnOrder, kTerms + 1>(models, records, count, phasors, terms, out);
   }
 }
 
-template <typename Out>
-void Predict(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order, Out* out) {
-  if (order < 0) return Dispatch<true>(models, first, count, phasors, models.max_order(), out);
+template <typename Records, typename Out>
+void Predict(const CompactModels& models, Records records, size_t count, const PhasorTable& phasors, int order,
+             Out* out) {
+  if (order < 0) return Dispatch<true>(models, records, count, phasors, models.max_order(), out);
   // Past L nothing is stored; past count the components are zero.
-  Dispatch<false>(models, first, count, phasors, std::min(order, models.max_order()), out);
+  Dispatch<false>(models, records, count, phasors, std::min(order, models.max_order()), out);
 }
 
 }  // namespace
 
 void PredictRegion(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order,
                    float* out) {
-  Predict(models, first, count, phasors, order, out);
+  Predict(models, Consecutive{first}, count, phasors, order, out);
 }
 
 void PredictRegionU8(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order,
                      uint8_t* out) {
-  Predict(models, first, count, phasors, order, out);
+  Predict(models, Consecutive{first}, count, phasors, order, out);
+}
+
+void PredictRecords(const CompactModels& models, std::span<const uint32_t> records, const PhasorTable& phasors,
+                    int order, float* out) {
+  Predict(models, Listed{records.data()}, records.size(), phasors, order, out);
 }
 
 }  // namespace fremen::model

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "storage/model/compact_models.h"
 #include "storage/model/phasor.h"
@@ -28,6 +29,12 @@ void PredictRegion(const CompactModels& models, size_t first, size_t count, cons
 // The same, quantised (QuantizeProbability).
 void PredictRegionU8(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order,
                      uint8_t* out);
+
+// out[i] = p(t) of record records[i], for i < records.size(), clamped to [0, 1]: the same kernel for
+// records that are not consecutive (the cells of a box, as a shard holds them). `order` as above.
+// REQUIRES: phasors of the models' Ω; every records[i] < models.size().
+void PredictRecords(const CompactModels& models, std::span<const uint32_t> records, const PhasorTable& phasors,
+                    int order, float* out);
 
 // Every record of `models`.
 inline void PredictRegion(const CompactModels& models, const PhasorTable& phasors, int order, float* out) {

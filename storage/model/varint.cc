@@ -36,20 +36,6 @@ size_t DecodeVarint(const unsigned char* p, size_t size, uint64_t* value, const 
   return 0;
 }
 
-template <typename T>
-T LoadLittleEndian(const char* p) {
-  T v = 0;
-  for (size_t i = 0; i < sizeof(T); ++i) v |= static_cast<T>(static_cast<unsigned char>(p[i])) << (8 * i);
-  return v;
-}
-
-template <typename T>
-void AppendLittleEndian(std::string* out, T v) {
-  char bytes[sizeof(T)];
-  for (size_t i = 0; i < sizeof(T); ++i) bytes[i] = static_cast<char>(v >> (8 * i));
-  out->append(bytes, sizeof(T));
-}
-
 }  // namespace
 
 void PutVarint64(std::string* out, uint64_t v) {
@@ -63,17 +49,16 @@ size_t Varint64Length(uint64_t v) {
   return static_cast<size_t>((bits + 6) / 7);
 }
 
-absl::StatusOr<uint64_t> GetVarint64(std::string_view* in) {
-  uint64_t v = 0;
-  const char* problem = nullptr;
-  const size_t n = DecodeVarint(reinterpret_cast<const unsigned char*>(in->data()), in->size(), &v, &problem);
-  if (n == 0) return absl::DataLossError(problem);
-  in->remove_prefix(n);
-  return v;
+void PutFixed32(std::string* out, uint32_t v) {
+  char bytes[4];
+  EncodeFixed32(bytes, v);
+  out->append(bytes, sizeof(bytes));
 }
-
-void PutFixed32(std::string* out, uint32_t v) { AppendLittleEndian(out, v); }
-void PutFixed64(std::string* out, uint64_t v) { AppendLittleEndian(out, v); }
+void PutFixed64(std::string* out, uint64_t v) {
+  char bytes[8];
+  EncodeFixed64(bytes, v);
+  out->append(bytes, sizeof(bytes));
+}
 void PutFloat(std::string* out, float v) { PutFixed32(out, std::bit_cast<uint32_t>(v)); }
 void PutFloats(std::string* out, std::span<const float> values) {
   if constexpr (std::endian::native == std::endian::little) {
@@ -122,14 +107,14 @@ uint8_t ByteReader::Byte(std::string_view field) {
 
 uint32_t ByteReader::Fixed32(std::string_view field) {
   if (!Need(4, field)) return 0;
-  const uint32_t v = LoadLittleEndian<uint32_t>(bytes_.data() + offset_);
+  const uint32_t v = DecodeFixed32(bytes_.data() + offset_);
   offset_ += 4;
   return v;
 }
 
 uint64_t ByteReader::Fixed64(std::string_view field) {
   if (!Need(8, field)) return 0;
-  const uint64_t v = LoadLittleEndian<uint64_t>(bytes_.data() + offset_);
+  const uint64_t v = DecodeFixed64(bytes_.data() + offset_);
   offset_ += 8;
   return v;
 }

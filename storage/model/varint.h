@@ -34,9 +34,6 @@ inline char* EncodeVarint64(char* dst, uint64_t v) {
 void PutVarint64(std::string* out, uint64_t v);
 // The encoded length of v in bytes (1..10).
 size_t Varint64Length(uint64_t v);
-// Reads a varint from the front of *in and advances past it. DataLoss on truncated, overlong (more
-// than 64 bits) or non-canonical (redundant trailing zero byte) input; *in is unchanged on error.
-absl::StatusOr<uint64_t> GetVarint64(std::string_view* in);
 
 // Zigzag maps signed to unsigned so that small magnitudes of either sign get short varints.
 inline uint64_t ZigZagEncode64(int64_t v) {
@@ -44,7 +41,31 @@ inline uint64_t ZigZagEncode64(int64_t v) {
 }
 inline int64_t ZigZagDecode64(uint64_t v) { return static_cast<int64_t>(v >> 1) ^ -static_cast<int64_t>(v & 1); }
 
-// Little-endian fixed-width values; float and double by their IEEE-754 bit patterns.
+// Little-endian fixed-width values at a position in raw bytes (REQUIRES: 4 or 8 bytes there), for
+// formats framed outside a ByteReader: the log's record headers, the LMDB record checksum, the
+// salvage child's frames.
+inline void EncodeFixed32(void* dst, uint32_t v) {
+  auto* p = static_cast<unsigned char*>(dst);
+  for (size_t i = 0; i < 4; ++i) p[i] = static_cast<unsigned char>(v >> (8 * i));
+}
+inline void EncodeFixed64(void* dst, uint64_t v) {
+  auto* p = static_cast<unsigned char*>(dst);
+  for (size_t i = 0; i < 8; ++i) p[i] = static_cast<unsigned char>(v >> (8 * i));
+}
+inline uint32_t DecodeFixed32(const void* src) {
+  const auto* p = static_cast<const unsigned char*>(src);
+  uint32_t v = 0;
+  for (size_t i = 0; i < 4; ++i) v |= uint32_t{p[i]} << (8 * i);
+  return v;
+}
+inline uint64_t DecodeFixed64(const void* src) {
+  const auto* p = static_cast<const unsigned char*>(src);
+  uint64_t v = 0;
+  for (size_t i = 0; i < 8; ++i) v |= uint64_t{p[i]} << (8 * i);
+  return v;
+}
+
+// Appended little-endian fixed-width values; float and double by their IEEE-754 bit patterns.
 void PutFixed32(std::string* out, uint32_t v);
 void PutFixed64(std::string* out, uint64_t v);
 void PutFloat(std::string* out, float v);
@@ -61,6 +82,8 @@ class ByteReader {
   // `record` names what is decoded in error messages, e.g. "lossless history".
   ByteReader(std::string_view bytes, std::string_view record) : bytes_(bytes), record_(record) {}
 
+  // A varint: fails (DataLoss) on truncated, overlong (more than 64 bits) or non-canonical
+  // (redundant trailing zero byte) input.
   uint64_t Varint(std::string_view field);
   uint8_t Byte(std::string_view field);
   uint32_t Fixed32(std::string_view field);

@@ -10,6 +10,16 @@
 namespace fremen::model {
 namespace {
 
+// One varint from the front of *in, advancing past it, through the decoders' ByteReader; *in is
+// unchanged on error.
+absl::StatusOr<uint64_t> ReadVarint(std::string_view* in) {
+  ByteReader reader(*in, "test");
+  const uint64_t v = reader.Varint("v");
+  if (!reader.ok()) return reader.status();
+  in->remove_prefix(reader.offset());
+  return v;
+}
+
 TEST(Varint, RoundTripsEdgeValues) {
   const uint64_t values[] = {0,           1,           127,         128,         16383, 16384, (1u << 21) - 1,
                              1u << 21,    0xffffffffu, 1ull << 32,  1ull << 56,  1ull << 63,
@@ -20,7 +30,7 @@ TEST(Varint, RoundTripsEdgeValues) {
     EXPECT_EQ(bytes.size(), Varint64Length(v)) << v;
     bytes += "tail";
     std::string_view in = bytes;
-    absl::StatusOr<uint64_t> got = GetVarint64(&in);
+    absl::StatusOr<uint64_t> got = ReadVarint(&in);
     ASSERT_TRUE(got.ok()) << got.status();
     EXPECT_EQ(*got, v);
     EXPECT_EQ(in, "tail");
@@ -42,7 +52,7 @@ TEST(Varint, RejectsTruncatedInputAndLeavesItUnchanged) {
   PutVarint64(&bytes, 1ull << 40);
   for (size_t n = 0; n < bytes.size(); ++n) {
     std::string_view in(bytes.data(), n);
-    absl::StatusOr<uint64_t> got = GetVarint64(&in);
+    absl::StatusOr<uint64_t> got = ReadVarint(&in);
     ASSERT_FALSE(got.ok()) << n;
     EXPECT_EQ(got.status().code(), absl::StatusCode::kDataLoss);
     EXPECT_EQ(in.size(), n);
@@ -53,25 +63,25 @@ TEST(Varint, RejectsOverlongInput) {
   // Eleven continuation bytes never end within 64 bits.
   const std::string eleven(11, '\x80');
   std::string_view in = eleven;
-  EXPECT_EQ(GetVarint64(&in).status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(ReadVarint(&in).status().code(), absl::StatusCode::kDataLoss);
   // Ten bytes whose last holds more than bit 63.
   std::string ten(9, '\xff');
   ten.push_back('\x02');
   in = ten;
-  EXPECT_EQ(GetVarint64(&in).status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(ReadVarint(&in).status().code(), absl::StatusCode::kDataLoss);
   // The largest value is fine.
   ten.back() = '\x01';
   in = ten;
-  EXPECT_EQ(*GetVarint64(&in), std::numeric_limits<uint64_t>::max());
+  EXPECT_EQ(*ReadVarint(&in), std::numeric_limits<uint64_t>::max());
 }
 
 TEST(Varint, RejectsNonCanonicalInput) {
   const std::string padded("\x80\x00", 2);  // 0 in two bytes
   std::string_view in = padded;
-  EXPECT_EQ(GetVarint64(&in).status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(ReadVarint(&in).status().code(), absl::StatusCode::kDataLoss);
   const std::string padded_one("\x81\x80\x00", 3);
   in = padded_one;
-  EXPECT_EQ(GetVarint64(&in).status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(ReadVarint(&in).status().code(), absl::StatusCode::kDataLoss);
 }
 
 TEST(Varint, RandomBytesNeverCrashAndDecodedValuesReencodeToTheSameBytes) {
@@ -80,7 +90,7 @@ TEST(Varint, RandomBytesNeverCrashAndDecodedValuesReencodeToTheSameBytes) {
     std::string bytes(rng() % 12, '\0');
     for (char& c : bytes) c = static_cast<char>(rng() % 4 == 0 ? rng() : (rng() | 0x80));
     std::string_view in = bytes;
-    absl::StatusOr<uint64_t> got = GetVarint64(&in);
+    absl::StatusOr<uint64_t> got = ReadVarint(&in);
     if (!got.ok()) continue;
     std::string again;
     PutVarint64(&again, *got);
@@ -114,6 +124,20 @@ TEST(Varint, FixedWidthValuesAreLittleEndian) {
   EXPECT_EQ(reader.Float("c"), -1.5f);
   EXPECT_EQ(reader.Double("d"), 0.1);
   EXPECT_TRUE(reader.Finish().ok());
+}
+
+TEST(Varint, FixedWidthValuesInRawBytesAreLittleEndianToo) {
+  unsigned char bytes[12] = {};
+  EncodeFixed32(bytes, 0x04030201u);
+  EncodeFixed64(bytes + 4, 0x0807060504030201ull);
+  const unsigned char want[12] = {1, 2, 3, 4, 1, 2, 3, 4, 5, 6, 7, 8};
+  EXPECT_EQ(std::string(reinterpret_cast<char*>(bytes), 12), std::string(reinterpret_cast<const char*>(want), 12));
+  EXPECT_EQ(DecodeFixed32(bytes), 0x04030201u);
+  EXPECT_EQ(DecodeFixed64(bytes + 4), 0x0807060504030201ull);
+  // High bytes survive (no sign extension through char).
+  EncodeFixed64(bytes, 0xfffefdfcfbfaf9f8ull);
+  EXPECT_EQ(DecodeFixed64(bytes), 0xfffefdfcfbfaf9f8ull);
+  EXPECT_EQ(DecodeFixed32(bytes + 4), 0xfffefdfcu);
 }
 
 TEST(Varint, ByteReaderErrorsAreStickyAndNameTheField) {

@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "storage/model/varint.h"
 
 namespace fremen::storage {
 
@@ -18,23 +19,6 @@ namespace {
 
 constexpr size_t kRecordHeader = 16;  // length, CRC, LSN
 constexpr uint32_t kMaxPayload = 256u << 20;
-
-void PutU32(std::vector<uint8_t>& out, uint32_t v) {
-  for (int i = 0; i < 4; ++i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
-}
-void PutU64(std::vector<uint8_t>& out, uint64_t v) {
-  for (int i = 0; i < 8; ++i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
-}
-uint32_t GetU32(const uint8_t* p) {
-  uint32_t v = 0;
-  for (int i = 3; i >= 0; --i) v = v << 8 | p[i];
-  return v;
-}
-uint64_t GetU64(const uint8_t* p) {
-  uint64_t v = 0;
-  for (int i = 7; i >= 0; --i) v = v << 8 | p[i];
-  return v;
-}
 
 uint32_t RecordCrc(const uint8_t* lsn_bytes, std::span<const uint8_t> payload) {
   uLong crc = crc32(0L, Z_NULL, 0);
@@ -84,12 +68,12 @@ struct Record {
 template <typename Plausible>
 std::optional<Record> IntactRecordAt(std::span<const uint8_t> data, size_t pos, Plausible plausible) {
   if (data.size() - pos < kRecordHeader) return std::nullopt;
-  const uint32_t length = GetU32(&data[pos]);
+  const uint32_t length = model::DecodeFixed32(&data[pos]);
   if (length > kMaxPayload || data.size() - pos - kRecordHeader < length) return std::nullopt;
-  const uint64_t lsn = GetU64(&data[pos + 8]);
+  const uint64_t lsn = model::DecodeFixed64(&data[pos + 8]);
   if (!plausible(lsn)) return std::nullopt;
   const std::span<const uint8_t> payload = data.subspan(pos + kRecordHeader, length);
-  if (GetU32(&data[pos + 4]) != RecordCrc(&data[pos + 8], payload)) return std::nullopt;
+  if (model::DecodeFixed32(&data[pos + 4]) != RecordCrc(&data[pos + 8], payload)) return std::nullopt;
   return Record{pos, lsn, payload};
 }
 
@@ -304,11 +288,11 @@ absl::Status WalWriter::OpenSegment(uint64_t first_lsn) {
 uint64_t WalWriter::Append(std::span<const uint8_t> payload) {
   const uint64_t lsn = next_lsn_++;
   if (buffer_.empty()) first_buffered_lsn_ = lsn;
-  uint8_t lsn_bytes[8];
-  for (int i = 0; i < 8; ++i) lsn_bytes[i] = static_cast<uint8_t>(lsn >> (8 * i));
-  PutU32(buffer_, static_cast<uint32_t>(payload.size()));
-  PutU32(buffer_, RecordCrc(lsn_bytes, payload));
-  PutU64(buffer_, lsn);
+  uint8_t header[kRecordHeader];
+  model::EncodeFixed32(header, static_cast<uint32_t>(payload.size()));
+  model::EncodeFixed64(header + 8, lsn);
+  model::EncodeFixed32(header + 4, RecordCrc(header + 8, payload));
+  buffer_.insert(buffer_.end(), header, header + kRecordHeader);
   buffer_.insert(buffer_.end(), payload.begin(), payload.end());
   return lsn;
 }
