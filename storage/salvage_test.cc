@@ -521,7 +521,7 @@ TEST(SalvageTest, ASalvageThatCannotWriteLeavesNothingBehind) {
 TEST(SalvageTest, ASalvagePastItsDeadlineMakesNoMap) {
   TempDir dir, image;
   const uint64_t id = CrashedAfterCheckpoint(dir, image, 1, 20, 8).id;
-  DamageLogRecord(OnlySegment(MapDir(image, id) + "/wal"), 35);
+  DamageLogRecord(OnlySegment(MapDirIn(image.path(), id) + "/wal"), 35);
   auto store = Store::Open(image.path(), {});
   ASSERT_TRUE(store.ok());
   ASSERT_EQ((*store)->FailedMaps().size(), 1u);
@@ -533,7 +533,7 @@ TEST(SalvageTest, ASalvagePastItsDeadlineMakesNoMap) {
   EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("m-salvaged").status()));
   std::vector<std::string> dirs;
   for (const auto& e : std::filesystem::directory_iterator(image.path() + "/maps")) dirs.push_back(e.path().string());
-  EXPECT_EQ(dirs, std::vector<std::string>{MapDir(image, id)});
+  EXPECT_EQ(dirs, std::vector<std::string>{MapDirIn(image.path(), id)});
   EXPECT_TRUE((*store)->SalvageMap("m", "").ok());
 }
 
