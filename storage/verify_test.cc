@@ -263,43 +263,57 @@ TEST(VerifyTest, AnOpenMapVerifiesCleanWhileItServes) {
   EXPECT_TRUE((*map)->Write(SweepScan(info, 1, 20, 100)).ok());
 }
 
+// A store in `dir` with grid map "source" (2 shards) holding `batches` scans, backed up to
+// `backup`/copy.
+struct BackedUpMap {
+  std::unique_ptr<Store> store;
+  MapInfo info;
+  std::string copy;
+};
+
+BackedUpMap BackUpAMap(const TempDir& dir, const TempDir& backup, uint64_t batches) {
+  BackedUpMap b;
+  auto store = Store::Open(dir.path(), {});
+  EXPECT_TRUE(store.ok()) << store.status();
+  b.store = *std::move(store);
+  auto info = b.store->CreateMap(GridMap("source", 64, 64, 1, 2));
+  EXPECT_TRUE(info.ok()) << info.status();
+  b.info = *info;
+  auto map = b.store->Map("source");
+  EXPECT_TRUE(map.ok());
+  for (uint64_t i = 0; i < batches; ++i) EXPECT_TRUE((*map)->Write(SweepScan(b.info, 1, i, 800)).ok());
+  b.copy = backup.path() + "/copy";
+  EXPECT_TRUE(b.store->BackupMap("source", b.copy).ok());
+  return b;
+}
+
 TEST(VerifyTest, ARestoreOfADamagedBackupIsRefusedAndCreatesNothing) {
   TempDir dir, backup;
-  auto store = Store::Open(dir.path(), {});
-  ASSERT_TRUE(store.ok()) << store.status();
-  auto info = (*store)->CreateMap(GridMap("source", 64, 64, 1, 2));
-  ASSERT_TRUE(info.ok()) << info.status();
-  {
-    auto map = (*store)->Map("source");
-    ASSERT_TRUE(map.ok());
-    for (uint64_t i = 0; i < 40; ++i) ASSERT_TRUE((*map)->Write(SweepScan(*info, 1, i, 800)).ok());
-  }
-  const std::string copy = backup.path() + "/copy";
-  ASSERT_TRUE((*store)->BackupMap("source", copy).ok());
-  EXPECT_TRUE(VerifyShards(copy, *info, {}).clean());
-  ASSERT_TRUE((*store)->RestoreMap(copy, "intact").ok());  // a sound backup restores
+  BackedUpMap b = BackUpAMap(dir, backup, 40);
+  ASSERT_FALSE(HasFailure());
+  auto& store = b.store;
+  const std::string& copy = b.copy;
+  EXPECT_TRUE(VerifyShards(copy, b.info, {}).clean());
+  ASSERT_TRUE(store->RestoreMap(copy, "intact").ok());  // a sound backup restores
 
   const std::string file = copy + "/shard-1/data.mdb";
   WriteAt(file, (fs::file_size(file) / 4096 / 2) * 4096, std::vector<uint8_t>(4096, 0));
   const auto maps_before = std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator());
-  const auto restored = (*store)->RestoreMap(copy, "restored");
+  const auto restored = store->RestoreMap(copy, "restored");
   ASSERT_TRUE(absl::IsDataLoss(restored.status())) << restored.status();
   EXPECT_TRUE(absl::StrContains(restored.status().message(), "shard-1/data.mdb")) << restored.status();
-  EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("restored").status()));
+  EXPECT_TRUE(absl::IsNotFound(store->GetMap("restored").status()));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator()), maps_before);
 }
 
 TEST(VerifyTest, ARestoreOrCheckPastItsDeadlineIsDeadlineExceededAndCreatesNothing) {
   TempDir dir, backup;
-  auto store = Store::Open(dir.path(), {});
-  ASSERT_TRUE(store.ok()) << store.status();
-  auto info = (*store)->CreateMap(GridMap("source", 64, 64, 1, 2));
-  ASSERT_TRUE(info.ok()) << info.status();
-  auto map = (*store)->Map("source");
+  BackedUpMap b = BackUpAMap(dir, backup, 10);
+  ASSERT_FALSE(HasFailure());
+  auto& store = b.store;
+  const std::string& copy = b.copy;
+  auto map = store->Map("source");
   ASSERT_TRUE(map.ok());
-  for (uint64_t i = 0; i < 10; ++i) ASSERT_TRUE((*map)->Write(SweepScan(*info, 1, i, 800)).ok());
-  const std::string copy = backup.path() + "/copy";
-  ASSERT_TRUE((*store)->BackupMap("source", copy).ok());
 
   // A deadline that has passed: no shard is read, and the check says so rather than "damaged".
   const VerifyReport late = (*map)->Verify(absl::InfinitePast());
@@ -311,13 +325,13 @@ TEST(VerifyTest, ARestoreOrCheckPastItsDeadlineIsDeadlineExceededAndCreatesNothi
   EXPECT_FALSE((*map)->Verify().deadline_exceeded);
 
   const auto maps_before = std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator());
-  const auto restored = (*store)->RestoreMap(copy, "late", absl::InfinitePast());
+  const auto restored = store->RestoreMap(copy, "late", absl::InfinitePast());
   ASSERT_TRUE(absl::IsDeadlineExceeded(restored.status())) << restored.status();
   EXPECT_TRUE(absl::StrContains(restored.status().message(), "was not restored: its check did not finish"))
       << restored.status();
-  EXPECT_TRUE(absl::IsNotFound((*store)->GetMap("late").status()));
+  EXPECT_TRUE(absl::IsNotFound(store->GetMap("late").status()));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path() + "/maps"), fs::directory_iterator()), maps_before);
-  EXPECT_TRUE((*store)->RestoreMap(copy, "in-time").ok());
+  EXPECT_TRUE(store->RestoreMap(copy, "in-time").ok());
 }
 
 TEST(VerifyTest, AnOpenMapVerifiesCleanWhileBatchesAndCheckpointsGoOn) {

@@ -46,6 +46,16 @@ class ProgressDisplay {
 
 }  // namespace
 
+void AddFollowOptions(CLI::App* command, FollowArgs& args, const std::string& when) {
+  const std::string prefix = when.empty() ? "" : when + ": ";
+  command->add_option("--poll-interval", args.poll_seconds, prefix + "seconds between polls")
+      ->check(CLI::Range(0.01, 60.0))
+      ->capture_default_str();
+  command->add_option("--line-interval", args.line_seconds, prefix + "not on a terminal, seconds between progress lines")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+}
+
 void FollowOperation(const Client& client, const std::string& command, const std::string& map,
                      const std::string& name, const FollowOptions& options) {
   ProgressDisplay display(options.line_interval);

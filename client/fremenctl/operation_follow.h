@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "CLI/CLI.hpp"
 #include "absl/time/time.h"
 #include "client/lib/client.h"
 
@@ -16,6 +17,18 @@ struct FollowOptions {
   // Not on a terminal: the least time between two progress lines.
   absl::Duration line_interval = absl::Seconds(10);
 };
+
+// FollowOptions as the command line gives them, in seconds.
+struct FollowArgs {
+  double poll_seconds = 0.5;
+  double line_seconds = 10;
+  FollowOptions options() const {
+    return {absl::Seconds(poll_seconds), absl::Seconds(line_seconds)};
+  }
+};
+
+// Adds --poll-interval and --line-interval to `command`; `when` opens their help ("with --wait").
+void AddFollowOptions(CLI::App* command, FollowArgs& args, const std::string& when = "");
 
 // `command` names the fremenctl command in error messages ("update", "operations wait").
 void FollowOperation(const Client& client, const std::string& command, const std::string& map,

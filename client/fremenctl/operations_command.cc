@@ -65,24 +65,15 @@ void RegisterOperationsCommand(CLI::App& app) {
   list->callback([list_args] { List(*list_args); });
 
   struct WaitArgs : OperationArgs {
-    double poll_seconds = 0.5;
-    double line_seconds = 10;
+    FollowArgs follow;
   };
   auto wait_args = std::make_shared<WaitArgs>();
   CLI::App* wait = operations->add_subcommand("wait", "Follow an operation to its end; exit 1 when it failed or was cancelled");
   AddOperationArgs(wait, *wait_args);
-  wait->add_option("--poll-interval", wait_args->poll_seconds, "seconds between polls")
-      ->check(CLI::Range(0.01, 60.0))
-      ->capture_default_str();
-  wait->add_option("--line-interval", wait_args->line_seconds, "not on a terminal: seconds between progress lines")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  AddFollowOptions(wait, wait_args->follow);
   wait->callback([wait_args] {
     Client client = ConnectOrExit("operations wait");
-    FollowOptions follow;
-    follow.poll_interval = absl::Seconds(wait_args->poll_seconds);
-    follow.line_interval = absl::Seconds(wait_args->line_seconds);
-    FollowOperation(client, "operations wait", wait_args->map, wait_args->name, follow);
+    FollowOperation(client, "operations wait", wait_args->map, wait_args->name, wait_args->follow.options());
   });
 
   auto cancel_args = std::make_shared<OperationArgs>();

@@ -15,8 +15,7 @@ namespace {
 struct UpdateArgs {
   std::string map;
   bool wait = false;
-  double poll_seconds = 0.5;
-  double line_seconds = 10;
+  FollowArgs follow;
 };
 
 void RunUpdate(const UpdateArgs& a) {
@@ -28,10 +27,7 @@ void RunUpdate(const UpdateArgs& a) {
                 a.map.c_str(), a.map.c_str());
     return;
   }
-  FollowOptions follow;
-  follow.poll_interval = absl::Seconds(a.poll_seconds);
-  follow.line_interval = absl::Seconds(a.line_seconds);
-  FollowOperation(client, "update", a.map, op->name(), follow);
+  FollowOperation(client, "update", a.map, op->name(), a.follow.options());
 }
 
 }  // namespace
@@ -43,12 +39,7 @@ void RegisterUpdateCommand(CLI::App& app) {
   update->add_flag("--wait", a->wait,
                    "follow the job to its end (a progress bar on a terminal, lines otherwise); exit 1 when it fails "
                    "or is cancelled");
-  update->add_option("--poll-interval", a->poll_seconds, "with --wait: seconds between polls")
-      ->check(CLI::Range(0.01, 60.0))
-      ->capture_default_str();
-  update->add_option("--line-interval", a->line_seconds, "with --wait, not on a terminal: seconds between lines")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  AddFollowOptions(update, a->follow, "with --wait");
   update->footer(
       "While an update of the map runs, a new request joins it: `fremenctl update --map M --wait` follows the "
       "running job.\nFor a nightly cron: fremenctl update --map M --wait || alert");
