@@ -13,19 +13,19 @@ absl::Status ShuttingDown() {
 }  // namespace
 
 absl::Status CallTracker::Begin() {
-  absl::MutexLock lock(&mutex_);
+  std::lock_guard lock(mutex_);
   if (draining_) return ShuttingDown();
   ++in_flight_;
   return absl::OkStatus();
 }
 
 void CallTracker::End() {
-  absl::MutexLock lock(&mutex_);
-  if (--in_flight_ == 0 && draining_) idle_.SignalAll();
+  std::lock_guard lock(mutex_);
+  if (--in_flight_ == 0 && draining_) idle_.notify_all();
 }
 
 absl::StatusOr<uint64_t> CallTracker::BeginStream(std::weak_ptr<Drainable> call) {
-  absl::MutexLock lock(&mutex_);
+  std::lock_guard lock(mutex_);
   if (draining_) return ShuttingDown();
   ++in_flight_;
   streams_.emplace(++next_stream_id_, std::move(call));
@@ -34,7 +34,7 @@ absl::StatusOr<uint64_t> CallTracker::BeginStream(std::weak_ptr<Drainable> call)
 
 void CallTracker::EndStream(uint64_t id) {
   {
-    absl::MutexLock lock(&mutex_);
+    std::lock_guard lock(mutex_);
     streams_.erase(id);
   }
   End();
@@ -43,7 +43,7 @@ void CallTracker::EndStream(uint64_t id) {
 int64_t CallTracker::Drain(absl::Duration timeout) {
   std::vector<std::shared_ptr<Drainable>> streams;
   {
-    absl::MutexLock lock(&mutex_);
+    std::lock_guard lock(mutex_);
     draining_ = true;
     for (auto& [id, weak] : streams_) {
       if (auto stream = weak.lock()) streams.push_back(std::move(stream));
@@ -53,11 +53,8 @@ int64_t CallTracker::Drain(absl::Duration timeout) {
   // Outside the lock: winding down may end the call at once.
   for (const auto& stream : streams) stream->WindDown();
   streams.clear();
-  const absl::Time deadline = absl::Now() + timeout;
-  absl::MutexLock lock(&mutex_);
-  while (in_flight_ != 0) {
-    if (idle_.WaitWithDeadline(&mutex_, deadline)) break;  // timed out
-  }
+  std::unique_lock lock(mutex_);
+  idle_.wait_for(lock, absl::ToChronoNanoseconds(timeout), [this] { return in_flight_ == 0; });
   return in_flight_;
 }
 

@@ -5,15 +5,16 @@
 //
 // Why Advance takes each waiter's mutex before notifying it: the waiter holds that mutex from its
 // registration until cv.wait releases it, so the notification cannot fall between the two and be
-// lost (absl::CondVar::Wait releases it atomically).
+// lost.
 // Thread-safety: every method may be called from any thread; a clock must outlive its waiters.
 #pragma once
 
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <vector>
 
-#include "absl/base/thread_annotations.h"
-#include "absl/synchronization/mutex.h"
 #include "server/clock.h"
 
 namespace fremen::server {
@@ -22,63 +23,60 @@ class FakeClock final : public Clock {
  public:
   explicit FakeClock(absl::Time now) : now_(now) {}
 
-  absl::Time Now() const override ABSL_LOCKS_EXCLUDED(mutex_) {
-    absl::MutexLock lock(&mutex_);
+  absl::Time Now() const override {
+    std::lock_guard lock(mutex_);
     return now_;
   }
 
-  void WaitUntil(absl::CondVar& cv, absl::Mutex& mu, absl::Time deadline) const override
-      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu) ABSL_LOCKS_EXCLUDED(mutex_) {
-    const Waiter self{&cv, &mu};
+  void WaitUntil(std::condition_variable& cv, std::unique_lock<std::mutex>& lock,
+                 absl::Time deadline) const override {
+    const Waiter self{&cv, lock.mutex()};
     {
-      absl::MutexLock guard(&mutex_);
+      std::lock_guard guard(mutex_);
       if (now_ >= deadline) return;
       waiters_.push_back(self);
+      waiters_changed_.notify_all();
     }
-    cv.Wait(&mu);
-    absl::MutexLock guard(&mutex_);
+    cv.wait(lock);
+    std::lock_guard guard(mutex_);
     // Still listed after a wake-up that was not Advance's (Stop, a spurious one).
     if (auto it = std::find(waiters_.begin(), waiters_.end(), self); it != waiters_.end()) waiters_.erase(it);
+    waiters_changed_.notify_all();
   }
 
-  void Set(absl::Time now) ABSL_LOCKS_EXCLUDED(mutex_) {
+  void Set(absl::Time now) {
     std::vector<Waiter> woken;
     {
-      absl::MutexLock guard(&mutex_);
+      std::lock_guard guard(mutex_);
       now_ = now;
       woken.swap(waiters_);
+      waiters_changed_.notify_all();
     }
     for (const Waiter& w : woken) {
-      absl::MutexLock waiter_lock(w.mutex);
-      w.cv->SignalAll();
+      std::lock_guard waiter_lock(*w.mutex);
+      w.cv->notify_all();
     }
   }
   void Advance(absl::Duration d) { Set(Now() + d); }
 
   // Blocks until `n` threads wait in WaitUntil; false when that has not happened within `timeout`
   // (a stuck thread fails the test instead of hanging it).
-  bool AwaitWaiters(size_t n, absl::Duration timeout = absl::Seconds(30)) const ABSL_LOCKS_EXCLUDED(mutex_) {
-    struct Enough {
-      const FakeClock* clock;
-      size_t n;
-      bool operator()() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(clock->mutex_) { return clock->waiters_.size() >= n; }
-    } enough{this, n};
-    absl::MutexLock guard(&mutex_);
-    return mutex_.AwaitWithTimeout(absl::Condition(&enough), timeout);
+  bool AwaitWaiters(size_t n, std::chrono::seconds timeout = std::chrono::seconds(30)) const {
+    std::unique_lock guard(mutex_);
+    return waiters_changed_.wait_for(guard, timeout, [&] { return waiters_.size() >= n; });
   }
 
  private:
   struct Waiter {
-    absl::CondVar* cv;
-    absl::Mutex* mutex;
+    std::condition_variable* cv;
+    std::mutex* mutex;
     bool operator==(const Waiter&) const = default;
   };
 
-  // The waiters' count is waited for with Mutex::AwaitWithTimeout, which re-checks it whenever the
-  // mutex is released: no condition variable of its own.
-  mutable absl::Mutex mutex_;
-  absl::Time now_ ABSL_GUARDED_BY(mutex_);
-  mutable std::vector<Waiter> waiters_ ABSL_GUARDED_BY(mutex_);
+  mutable std::mutex mutex_;
+  mutable std::condition_variable waiters_changed_;
+  absl::Time now_;
+  mutable std::vector<Waiter> waiters_;
 };
 
 }  // namespace fremen::server

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
@@ -34,7 +35,7 @@ Scrubber::Scrubber(Options options, const Clock& clock, MapLister list_maps, Che
     : options_(options), clock_(clock), list_maps_(std::move(list_maps)), check_(std::move(check)) {}
 
 void Scrubber::Start() {
-  absl::MutexLock lock(&mutex_);
+  std::lock_guard lock(mutex_);
   if (!enabled()) {
     DaemonLog()->info("no background scrub (scrub_interval 0): maps are checked only on demand (CheckMap)");
     return;
@@ -47,21 +48,21 @@ void Scrubber::Start() {
 
 void Scrubber::Stop() {
   {
-    absl::MutexLock lock(&mutex_);
+    std::lock_guard lock(mutex_);
     stopping_ = true;
     next_ = absl::InfiniteFuture();
-    wake_.SignalAll();
+    wake_.notify_all();
   }
   if (thread_.joinable()) thread_.join();
 }
 
 absl::Time Scrubber::NextPass() const {
-  absl::MutexLock lock(&mutex_);
+  std::lock_guard lock(mutex_);
   return next_;
 }
 
 std::vector<Scrubber::Result> Scrubber::Results() const {
-  absl::MutexLock lock(&mutex_);
+  std::lock_guard lock(mutex_);
   std::vector<Result> results;
   results.reserve(results_.size());
   for (const auto& [map, result] : results_) results.push_back(result);
@@ -69,27 +70,23 @@ std::vector<Scrubber::Result> Scrubber::Results() const {
 }
 
 bool Scrubber::AwaitPasses(uint64_t passes, absl::Duration timeout) const {
-  const absl::Time deadline = absl::Now() + timeout;
-  absl::MutexLock lock(&mutex_);
-  while (passes_ < passes) {
-    if (pass_done_.WaitWithDeadline(&mutex_, deadline)) return passes_ >= passes;  // timed out
-  }
-  return true;
+  std::unique_lock lock(mutex_);
+  return pass_done_.wait_for(lock, absl::ToChronoNanoseconds(timeout), [&] { return passes_ >= passes; });
 }
 
 void Scrubber::Run() {
   if (options_.low_priority) LowerThisThreadsPriority();
-  absl::MutexLock lock(&mutex_);
+  std::unique_lock lock(mutex_);
   while (!stopping_) {
     if (clock_.Now() < next_) {
-      clock_.WaitUntil(wake_, mutex_, next_);
+      clock_.WaitUntil(wake_, lock, next_);
       continue;
     }
-    mutex_.Unlock();
+    lock.unlock();
     Pass();
-    mutex_.Lock();
+    lock.lock();
     ++passes_;
-    pass_done_.SignalAll();
+    pass_done_.notify_all();
     // From the end of this pass: a pass that takes longer than the interval is not followed at once
     // by the next one.
     if (!stopping_) next_ = clock_.Now() + options_.interval;
@@ -103,14 +100,14 @@ void Scrubber::Pass() {
     return;
   }
   {
-    absl::MutexLock lock(&mutex_);
+    std::lock_guard lock(mutex_);
     for (auto it = results_.begin(); it != results_.end();) {
       it = std::find(maps->begin(), maps->end(), it->first) == maps->end() ? results_.erase(it) : std::next(it);
     }
   }
   for (const std::string& map : *maps) {
     {
-      absl::MutexLock lock(&mutex_);
+      std::lock_guard lock(mutex_);
       if (stopping_) return;
     }
     Scrub(map);
@@ -141,7 +138,7 @@ void Scrubber::Scrub(const std::string& map) {
     DaemonLog()->error("scrub of map {}: {} problems, first {}", map, result.problem_count,
                        storage::FormatProblem(report->problems.front()));
   }
-  absl::MutexLock lock(&mutex_);
+  std::lock_guard lock(mutex_);
   results_[map] = std::move(result);
 }
 

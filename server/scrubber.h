@@ -13,16 +13,16 @@
 // Thread-safety: Start and Stop from one thread; Results, NextPass, AwaitPasses from any thread.
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "absl/base/thread_annotations.h"
 #include "absl/container/btree_map.h"
 #include "absl/status/statusor.h"
-#include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "server/clock.h"
 #include "storage/verify.h"
@@ -61,38 +61,37 @@ class Scrubber {
   Scrubber& operator=(const Scrubber&) = delete;
 
   // Starts the thread; does nothing when the interval is 0.
-  void Start() ABSL_LOCKS_EXCLUDED(mutex_);
+  void Start();
   // Stops and joins the thread; a pass under way stops after the map it is verifying. Idempotent.
-  void Stop() ABSL_LOCKS_EXCLUDED(mutex_);
+  void Stop();
 
   bool enabled() const { return options_.interval > absl::ZeroDuration(); }
   // When the next pass starts; InfiniteFuture when off or stopped.
-  absl::Time NextPass() const ABSL_LOCKS_EXCLUDED(mutex_);
+  absl::Time NextPass() const;
   // Each map's latest result, in map name order (maps no longer listed are dropped at each pass).
-  std::vector<Result> Results() const ABSL_LOCKS_EXCLUDED(mutex_);
+  std::vector<Result> Results() const;
   // Waits until `passes` passes have finished since Start, or `timeout` (real time) has passed;
   // returns whether they have. For tests, which move a fake clock and then wait for the thread.
-  bool AwaitPasses(uint64_t passes, absl::Duration timeout) const ABSL_LOCKS_EXCLUDED(mutex_);
+  bool AwaitPasses(uint64_t passes, absl::Duration timeout) const;
 
  private:
-  void Run() ABSL_LOCKS_EXCLUDED(mutex_);
-  // Both called without the lock: a pass takes long, and NextPass/Results answer meanwhile.
-  void Pass() ABSL_LOCKS_EXCLUDED(mutex_);
-  void Scrub(const std::string& map) ABSL_LOCKS_EXCLUDED(mutex_);
+  void Run();
+  void Pass();
+  void Scrub(const std::string& map);
 
   const Options options_;
   const Clock& clock_;
   const MapLister list_maps_;
   const Check check_;
 
-  mutable absl::Mutex mutex_;
-  mutable absl::CondVar wake_;       // Stop, the clock
-  mutable absl::CondVar pass_done_;  // AwaitPasses
-  absl::Time next_ ABSL_GUARDED_BY(mutex_) = absl::InfiniteFuture();
-  uint64_t passes_ ABSL_GUARDED_BY(mutex_) = 0;
-  bool stopping_ ABSL_GUARDED_BY(mutex_) = false;
-  absl::btree_map<std::string, Result> results_ ABSL_GUARDED_BY(mutex_);
-  std::thread thread_;  // Start and Stop's (one thread)
+  mutable std::mutex mutex_;
+  mutable std::condition_variable wake_;      // Stop, the clock
+  mutable std::condition_variable pass_done_;  // AwaitPasses
+  absl::Time next_ = absl::InfiniteFuture();
+  uint64_t passes_ = 0;
+  bool stopping_ = false;
+  absl::btree_map<std::string, Result> results_;
+  std::thread thread_;
 };
 
 }  // namespace fremen::server

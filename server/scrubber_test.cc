@@ -88,7 +88,7 @@ TEST(ScrubberTest, AnIntervalOfZeroStartsNothing) {
   EXPECT_FALSE(scrubber.enabled());
   EXPECT_EQ(scrubber.NextPass(), absl::InfiniteFuture());
   // A started thread would be waiting on the clock for its first pass: none is.
-  EXPECT_FALSE(clock.AwaitWaiters(1, absl::Seconds(1)));
+  EXPECT_FALSE(clock.AwaitWaiters(1, std::chrono::seconds(1)));
   clock.Advance(absl::Hours(1000));
   EXPECT_FALSE(scrubber.AwaitPasses(1, absl::ZeroDuration()));
   EXPECT_THAT(store.Checked(), IsEmpty());

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <mutex>
 #include <optional>
 
 #include "absl/container/flat_hash_set.h"
@@ -562,7 +563,7 @@ namespace fremen::storage {
 absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const std::string& new_name,
                                                 absl::Time deadline) {
   const std::string target_name = new_name.empty() ? name + "-salvaged" : new_name;
-  absl::MutexLock lock(&mutex_);
+  std::unique_lock lock(mutex_);
   const auto failed = failed_.find(name);
   if (failed == failed_.end()) {
     if (maps_.contains(name)) {
@@ -593,7 +594,7 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
   const std::string from_dir = failed->second.dir;
   salvaging_.insert(name);
   salvaging_.insert(target_name);
-  mutex_.Unlock();
+  lock.unlock();
   // The id has no directory (Create skipped those that do): everything under `target` is this call's, and only that is
   // removed when the salvage fails.
   const std::string target = MapDir(created->id);
@@ -605,7 +606,7 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
   } else {
     report = SalvageFiles(from_dir, target, *created, options_, deadline);
   }
-  mutex_.Lock();
+  lock.lock();
   salvaging_.erase(name);
   salvaging_.erase(target_name);
   if (report.ok()) {

@@ -3,12 +3,10 @@
 #include <fftw3.h>
 
 #include <algorithm>
+#include <mutex>
 #include <type_traits>
 #include <utility>
 #include <vector>
-
-#include "absl/base/thread_annotations.h"
-#include "absl/synchronization/mutex.h"
 
 namespace fremen::model {
 
@@ -20,8 +18,8 @@ using Plan = std::shared_ptr<std::remove_pointer_t<fftw_plan>>;
 // Lengths differ from state to state, so only the most recently used few plans are kept.
 struct PlanCache {
   static constexpr size_t kMaxPlans = 16;
-  absl::Mutex mu;
-  std::vector<std::pair<int, Plan>> plans ABSL_GUARDED_BY(mu);  // most recently used last
+  std::mutex mu;
+  std::vector<std::pair<int, Plan>> plans;  // most recently used last
 };
 
 PlanCache& Cache() {
@@ -35,7 +33,7 @@ PlanCache& Cache() {
 Plan InPlaceR2cPlan(int n, double* buffer) {
   PlanCache& cache = Cache();
   Plan evicted;  // released after the lock: its deleter takes the lock
-  absl::MutexLock lock(&cache.mu);
+  std::lock_guard<std::mutex> lock(cache.mu);
   auto it = std::find_if(cache.plans.begin(), cache.plans.end(), [n](const auto& e) { return e.first == n; });
   if (it != cache.plans.end()) {
     std::rotate(it, it + 1, cache.plans.end());
@@ -43,7 +41,7 @@ Plan InPlaceR2cPlan(int n, double* buffer) {
   }
   Plan plan(fftw_plan_dft_r2c_1d(n, buffer, reinterpret_cast<fftw_complex*>(buffer), FFTW_ESTIMATE),
             [](fftw_plan p) {
-              absl::MutexLock l(&Cache().mu);
+              std::lock_guard<std::mutex> l(Cache().mu);
               fftw_destroy_plan(p);
             });
   if (cache.plans.size() == PlanCache::kMaxPlans) {
