@@ -33,14 +33,6 @@ absl::Status WriteDataDirFormat(Env* env, const std::string& data_dir) {
 }
 
 absl::Status UnreadableFormatError(const std::string& data_dir, int format) {
-  if (format == 1) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        data_dir, " has no FORMAT file and every catalog record fails its checksum: it was written by a fremend from "
-        "before the record checksums (data directory format 1), which this fremend (format ", kDataDirFormat,
-        ") cannot read. Its maps were left as they are: serve it with the fremend that wrote it, or start this one on a new "
-        "data directory. (If this directory was written by this version, its catalog is damaged: fremend --verify "
-        "reports it.)"));
-  }
   return absl::FailedPreconditionError(absl::StrCat(
       data_dir, " is data directory format ", format, ", written by a newer fremend; this one reads format ",
       kDataDirFormat, ". Its maps were left as they are: serve it with the fremend that wrote it."));

@@ -4,8 +4,9 @@
 // format").
 //
 // Format 2 is the first with a checksum in every LMDB record. Format 1 (no record checksums, no
-// FORMAT file) cannot be read by this version; a directory without a FORMAT file whose catalog
-// records all fail their checksum is taken for one and refused, nothing changed.
+// FORMAT file) cannot be read by this version: its catalog is refused when it is opened
+// (LmdbEnv's record format check, lmdb/lmdb_env.h). A directory without the file whose catalog
+// opens was written by format 2 before it kept the file, and is marked.
 // Thread-safety: pure functions over the file system.
 #pragma once
 

@@ -35,7 +35,6 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& data_dir, 
   if (!format.ok()) return format.status();
   if (*format != 0 && *format != kDataDirFormat) return UnreadableFormatError(data_dir, *format);
   std::error_code error;
-  const bool had_catalog = fs::exists(data_dir + "/catalog/data.mdb", error);
   fs::create_directories(data_dir + "/maps", error);
   if (error) return absl::InternalError(absl::StrCat("cannot create ", data_dir, "/maps: ", error.message()));
   if (options.probe_before_open) {
@@ -52,9 +51,9 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& data_dir, 
   std::vector<MapInfo> all;
   std::vector<DamagedCatalogEntry> damaged;
   if (absl::Status listed = store->ListCatalog(all, damaged); !listed.ok()) return listed;
+  // No FORMAT: a new directory, or one this format wrote before it kept the file (format 1's, with
+  // no record checksums, stopped at Catalog::Open: LmdbEnv refuses records without checksums).
   if (*format == 0) {
-    // No FORMAT: a new directory, one this format wrote before it kept the file, or format 1.
-    if (had_catalog && all.empty() && !damaged.empty()) return UnreadableFormatError(data_dir, 1);
     if (absl::Status written = WriteDataDirFormat(options.env, data_dir); !written.ok()) return written;
   }
   std::lock_guard lock(store->mutex_);
