@@ -10,7 +10,7 @@ JOBS ?= $(shell nproc)
 ARGS ?=
 
 .PHONY: all deps configure build run demo-eval test bench asan tsan sanitize-ci asan-ci tsan-ci fuzz fuzz-smoke \
-        clean
+        thread-safety clean
 
 all: build
 
@@ -60,6 +60,12 @@ asan-ci: deps
 tsan-ci: deps
 	@bash scripts/sanitize-ci.sh thread build-tsan $(JOBS) $(SANITIZE_TESTS)
 
+# clang's thread-safety analysis (ABSL_GUARDED_BY and friends) over the storage, server and client
+# libraries, in build-tsa/: any locking annotation violated fails the build.
+thread-safety: deps
+	@bash scripts/install-deps.sh clang
+	@bash scripts/thread-safety-check.sh build-tsa $(JOBS)
+
 # libFuzzer targets (fuzz/README.md), built with clang in build-fuzz/; each runs FUZZ_SECONDS.
 FUZZ_SECONDS ?= 60
 
@@ -72,4 +78,4 @@ fuzz-smoke:
 	@bash fuzz/run.sh build-fuzz 10 $(JOBS)
 
 clean:
-	@rm -rf $(BUILD) build-asan build-tsan build-fuzz
+	@rm -rf $(BUILD) build-asan build-tsan build-fuzz build-tsa

@@ -3,6 +3,7 @@
 # Idempotent: does nothing (and needs no network) when everything is already there.
 #   scripts/install-deps.sh        what the build and `make test` need
 #   scripts/install-deps.sh fuzz   also clang and its libFuzzer runtime (`make fuzz`, fuzz/README.md)
+#   scripts/install-deps.sh clang  also clang (`make thread-safety`: its thread-safety analysis)
 set -euo pipefail
 
 packages=(
@@ -15,9 +16,10 @@ packages=(
   mypy python3-pycodestyle  # the Python package's type and style checks (python.mypy, python.pycodestyle)
   openssl  # the tests make their TLS certificates with it
 )
-if [ "${1:-}" = fuzz ]; then
-  packages+=(clang-14 libclang-rt-14-dev)  # libclang_rt.fuzzer, asan and ubsan for clang
-fi
+case "${1:-}" in
+  fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;  # libclang_rt.fuzzer, asan and ubsan for clang
+  clang) packages+=(clang-14) ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

@@ -226,12 +226,12 @@ absl::Status AdminServiceImpl::Backup(const v1::BackupMapRequest& request, const
 }
 
 bool AdminServiceImpl::ClaimBackupDir(const std::string& dir) const {
-  std::lock_guard lock(backups_mutex_);
+  base::MutexLock lock(&backups_mutex_);
   return backups_in_progress_.insert(dir).second;
 }
 
 void AdminServiceImpl::ReleaseBackupDir(const std::string& dir) const {
-  std::lock_guard lock(backups_mutex_);
+  base::MutexLock lock(&backups_mutex_);
   backups_in_progress_.erase(dir);
 }
 

@@ -11,10 +11,11 @@
 // service's one mutable member, the backups in progress, has its own mutex.
 #pragma once
 
-#include <mutex>
 #include <string>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_set.h"
+#include "base/mutex.h"
 #include "absl/time/time.h"
 #include "fremen/v1/admin.grpc.pb.h"
 #include "server/clock.h"
@@ -78,14 +79,14 @@ class AdminServiceImpl final : public v1::AdminService::CallbackService {
 
   // Claims a backup directory for one call (false: another backup is writing there), so that two
   // concurrent backups never interleave in one directory.
-  bool ClaimBackupDir(const std::string& dir) const;
-  void ReleaseBackupDir(const std::string& dir) const;
+  bool ClaimBackupDir(const std::string& dir) const ABSL_LOCKS_EXCLUDED(backups_mutex_);
+  void ReleaseBackupDir(const std::string& dir) const ABSL_LOCKS_EXCLUDED(backups_mutex_);
 
   const ServiceDeps deps_;
   const AdminDeps admin_;
   const absl::Time start_time_;
-  mutable std::mutex backups_mutex_;
-  mutable absl::flat_hash_set<std::string> backups_in_progress_;
+  mutable base::Mutex backups_mutex_;
+  mutable absl::flat_hash_set<std::string> backups_in_progress_ ABSL_GUARDED_BY(backups_mutex_);
 };
 
 }  // namespace fremen::server

@@ -14,21 +14,21 @@ BlockingPool::BlockingPool(std::string name, size_t threads, size_t max_queued) 
 
 bool BlockingPool::Post(std::function<void()> work) {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     if (stopping_ || queue_.size() >= max_queued_) return false;
     queue_.push_back(std::move(work));
   }
-  ready_.notify_one();
+  ready_.Signal();
   return true;
 }
 
 void BlockingPool::Stop() {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     if (stopping_ && threads_.empty()) return;
     stopping_ = true;
   }
-  ready_.notify_all();
+  ready_.SignalAll();
   for (std::thread& thread : threads_) thread.join();
   threads_.clear();
 }
@@ -37,8 +37,8 @@ void BlockingPool::Run() {
   for (;;) {
     std::function<void()> work;
     {
-      std::unique_lock lock(mutex_);
-      ready_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      base::MutexLock lock(&mutex_);
+      while (!stopping_ && queue_.empty()) ready_.Wait(&mutex_);
       if (queue_.empty()) return;  // stopping, and everything queued has run
       work = std::move(queue_.front());
       queue_.pop_front();

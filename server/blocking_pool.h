@@ -6,14 +6,15 @@
 // the owner's thread: it runs the queued work, then joins the threads; Post after Stop refuses.
 #pragma once
 
-#include <condition_variable>
 #include <cstddef>
 #include <deque>
 #include <functional>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "base/mutex.h"
 
 namespace fremen::server {
 
@@ -26,18 +27,18 @@ class BlockingPool {
   BlockingPool& operator=(const BlockingPool&) = delete;
 
   // Queues `work`; false when the queue is full or the pool is stopping.
-  [[nodiscard]] bool Post(std::function<void()> work);
-  void Stop();
+  [[nodiscard]] bool Post(std::function<void()> work) ABSL_LOCKS_EXCLUDED(mutex_);
+  void Stop() ABSL_LOCKS_EXCLUDED(mutex_);
 
  private:
-  void Run();
+  void Run() ABSL_LOCKS_EXCLUDED(mutex_);
 
   const size_t max_queued_;
-  std::mutex mutex_;
-  std::condition_variable ready_;
-  std::deque<std::function<void()>> queue_;
-  bool stopping_ = false;
-  std::vector<std::thread> threads_;
+  base::Mutex mutex_;
+  base::CondVar ready_;
+  std::deque<std::function<void()>> queue_ ABSL_GUARDED_BY(mutex_);
+  bool stopping_ ABSL_GUARDED_BY(mutex_) = false;
+  std::vector<std::thread> threads_;  // the constructor's and Stop's (the owner's thread)
 };
 
 }  // namespace fremen::server

@@ -13,19 +13,19 @@ absl::Status ShuttingDown() {
 }  // namespace
 
 absl::Status CallTracker::Begin() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (draining_) return ShuttingDown();
   ++in_flight_;
   return absl::OkStatus();
 }
 
 void CallTracker::End() {
-  std::lock_guard lock(mutex_);
-  if (--in_flight_ == 0 && draining_) idle_.notify_all();
+  base::MutexLock lock(&mutex_);
+  if (--in_flight_ == 0 && draining_) idle_.SignalAll();
 }
 
 absl::StatusOr<uint64_t> CallTracker::BeginStream(std::weak_ptr<Drainable> call) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (draining_) return ShuttingDown();
   ++in_flight_;
   streams_.emplace(++next_stream_id_, std::move(call));
@@ -34,7 +34,7 @@ absl::StatusOr<uint64_t> CallTracker::BeginStream(std::weak_ptr<Drainable> call)
 
 void CallTracker::EndStream(uint64_t id) {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     streams_.erase(id);
   }
   End();
@@ -43,7 +43,7 @@ void CallTracker::EndStream(uint64_t id) {
 int64_t CallTracker::Drain(absl::Duration timeout) {
   std::vector<std::shared_ptr<Drainable>> streams;
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     draining_ = true;
     for (auto& [id, weak] : streams_) {
       if (auto stream = weak.lock()) streams.push_back(std::move(stream));
@@ -53,8 +53,11 @@ int64_t CallTracker::Drain(absl::Duration timeout) {
   // Outside the lock: winding down may end the call at once.
   for (const auto& stream : streams) stream->WindDown();
   streams.clear();
-  std::unique_lock lock(mutex_);
-  idle_.wait_for(lock, absl::ToChronoNanoseconds(timeout), [this] { return in_flight_ == 0; });
+  const absl::Time deadline = absl::Now() + timeout;
+  base::MutexLock lock(&mutex_);
+  while (in_flight_ != 0) {
+    if (idle_.WaitWithDeadline(&mutex_, deadline)) break;  // timed out
+  }
   return in_flight_;
 }
 

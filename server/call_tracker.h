@@ -7,14 +7,14 @@
 // Thread-safety: every method may be called from any thread.
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <memory>
-#include <mutex>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "base/mutex.h"
 #include "absl/time/time.h"
 
 namespace fremen::server {
@@ -34,24 +34,24 @@ class CallTracker {
   };
 
   // Registers a call; Unavailable while draining. Every successful Begin needs one End.
-  absl::Status Begin();
-  void End();
+  absl::Status Begin() ABSL_LOCKS_EXCLUDED(mutex_);
+  void End() ABSL_LOCKS_EXCLUDED(mutex_);
   // Begin() for a long-lived call, which Drain asks to wind down unless it has ended (or is gone:
   // the tracker holds it weakly). The id for EndStream; Unavailable while draining.
-  absl::StatusOr<uint64_t> BeginStream(std::weak_ptr<Drainable> call);
+  absl::StatusOr<uint64_t> BeginStream(std::weak_ptr<Drainable> call) ABSL_LOCKS_EXCLUDED(mutex_);
   // End() for a call begun with BeginStream.
-  void EndStream(uint64_t id);
+  void EndStream(uint64_t id) ABSL_LOCKS_EXCLUDED(mutex_);
   // Refuses new calls from now on and waits until none is in flight or `timeout` has passed. The
   // calls still in flight (0 when drained).
-  int64_t Drain(absl::Duration timeout);
+  int64_t Drain(absl::Duration timeout) ABSL_LOCKS_EXCLUDED(mutex_);
 
  private:
-  std::mutex mutex_;
-  std::condition_variable idle_;
-  int64_t in_flight_ = 0;
-  bool draining_ = false;
-  uint64_t next_stream_id_ = 0;
-  absl::flat_hash_map<uint64_t, std::weak_ptr<Drainable>> streams_;
+  base::Mutex mutex_;
+  base::CondVar idle_;
+  int64_t in_flight_ ABSL_GUARDED_BY(mutex_) = 0;
+  bool draining_ ABSL_GUARDED_BY(mutex_) = false;
+  uint64_t next_stream_id_ ABSL_GUARDED_BY(mutex_) = 0;
+  absl::flat_hash_map<uint64_t, std::weak_ptr<Drainable>> streams_ ABSL_GUARDED_BY(mutex_);
 };
 
 }  // namespace fremen::server

@@ -7,11 +7,10 @@
 // Thread-safety: implementations may be used from any thread.
 #pragma once
 
-#include <condition_variable>
-#include <mutex>
-
+#include "absl/base/thread_annotations.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "base/mutex.h"
 
 namespace fremen::server {
 
@@ -19,26 +18,22 @@ class Clock {
  public:
   virtual ~Clock() = default;
   virtual absl::Time Now() const = 0;
-  // Waits on `cv` (`lock` held, as for cv.wait) until it is notified or Now() reaches `deadline`
-  // (InfiniteFuture: only a notification ends the wait). May return early: callers re-check what
-  // they wait for, as with any condition variable.
-  virtual void WaitUntil(std::condition_variable& cv, std::unique_lock<std::mutex>& lock,
-                         absl::Time deadline) const = 0;
+  // Waits on `cv` (releasing `mu`, as cv.Wait does) until it is notified or Now() reaches
+  // `deadline` (InfiniteFuture: only a notification ends the wait). May return early: callers
+  // re-check what they wait for, as with any condition variable.
+  virtual void WaitUntil(base::CondVar& cv, base::Mutex& mu, absl::Time deadline) const
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu) = 0;
 };
 
 // The wall clock. A deadline is a wall-clock time, so a clock stepped by NTP or a machine that
-// slept still wakes the waiter at the right local time (glibc waits on CLOCK_REALTIME for
-// system_clock deadlines).
+// slept still wakes the waiter at the right local time (CondVar::WaitWithDeadline waits on
+// CLOCK_REALTIME).
 class RealClock final : public Clock {
  public:
   absl::Time Now() const override { return absl::Now(); }
-  void WaitUntil(std::condition_variable& cv, std::unique_lock<std::mutex>& lock,
-                 absl::Time deadline) const override {
-    if (deadline == absl::InfiniteFuture()) {
-      cv.wait(lock);
-    } else {
-      cv.wait_until(lock, absl::ToChronoTime(deadline));
-    }
+  void WaitUntil(base::CondVar& cv, base::Mutex& mu, absl::Time deadline) const override
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu) {
+    cv.WaitWithDeadline(&mu, deadline);
   }
 
   // The one instance the daemon uses.

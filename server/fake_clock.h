@@ -5,16 +5,16 @@
 //
 // Why Advance takes each waiter's mutex before notifying it: the waiter holds that mutex from its
 // registration until cv.wait releases it, so the notification cannot fall between the two and be
-// lost.
+// lost (CondVar::Wait releases it atomically).
 // Thread-safety: every method may be called from any thread; a clock must outlive its waiters.
 #pragma once
 
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
-#include <mutex>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
+#include "base/mutex.h"
 #include "server/clock.h"
 
 namespace fremen::server {
@@ -23,60 +23,65 @@ class FakeClock final : public Clock {
  public:
   explicit FakeClock(absl::Time now) : now_(now) {}
 
-  absl::Time Now() const override {
-    std::lock_guard lock(mutex_);
+  absl::Time Now() const override ABSL_LOCKS_EXCLUDED(mutex_) {
+    base::MutexLock lock(&mutex_);
     return now_;
   }
 
-  void WaitUntil(std::condition_variable& cv, std::unique_lock<std::mutex>& lock,
-                 absl::Time deadline) const override {
-    const Waiter self{&cv, lock.mutex()};
+  void WaitUntil(base::CondVar& cv, base::Mutex& mu, absl::Time deadline) const override
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu) ABSL_LOCKS_EXCLUDED(mutex_) {
+    const Waiter self{&cv, &mu};
     {
-      std::lock_guard guard(mutex_);
+      base::MutexLock guard(&mutex_);
       if (now_ >= deadline) return;
       waiters_.push_back(self);
-      waiters_changed_.notify_all();
+      waiters_changed_.SignalAll();
     }
-    cv.wait(lock);
-    std::lock_guard guard(mutex_);
+    cv.Wait(&mu);
+    base::MutexLock guard(&mutex_);
     // Still listed after a wake-up that was not Advance's (Stop, a spurious one).
     if (auto it = std::find(waiters_.begin(), waiters_.end(), self); it != waiters_.end()) waiters_.erase(it);
-    waiters_changed_.notify_all();
+    waiters_changed_.SignalAll();
   }
 
-  void Set(absl::Time now) {
+  void Set(absl::Time now) ABSL_LOCKS_EXCLUDED(mutex_) {
     std::vector<Waiter> woken;
     {
-      std::lock_guard guard(mutex_);
+      base::MutexLock guard(&mutex_);
       now_ = now;
       woken.swap(waiters_);
-      waiters_changed_.notify_all();
+      waiters_changed_.SignalAll();
     }
     for (const Waiter& w : woken) {
-      std::lock_guard waiter_lock(*w.mutex);
-      w.cv->notify_all();
+      base::MutexLock waiter_lock(w.mutex);
+      w.cv->SignalAll();
     }
   }
   void Advance(absl::Duration d) { Set(Now() + d); }
 
   // Blocks until `n` threads wait in WaitUntil; false when that has not happened within `timeout`
   // (a stuck thread fails the test instead of hanging it).
-  bool AwaitWaiters(size_t n, std::chrono::seconds timeout = std::chrono::seconds(30)) const {
-    std::unique_lock guard(mutex_);
-    return waiters_changed_.wait_for(guard, timeout, [&] { return waiters_.size() >= n; });
+  bool AwaitWaiters(size_t n, std::chrono::seconds timeout = std::chrono::seconds(30)) const
+      ABSL_LOCKS_EXCLUDED(mutex_) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    base::MutexLock guard(&mutex_);
+    while (waiters_.size() < n) {
+      if (waiters_changed_.WaitUntil(&mutex_, deadline)) return waiters_.size() >= n;  // timed out
+    }
+    return true;
   }
 
  private:
   struct Waiter {
-    std::condition_variable* cv;
-    std::mutex* mutex;
+    base::CondVar* cv;
+    base::Mutex* mutex;
     bool operator==(const Waiter&) const = default;
   };
 
-  mutable std::mutex mutex_;
-  mutable std::condition_variable waiters_changed_;
-  absl::Time now_;
-  mutable std::vector<Waiter> waiters_;
+  mutable base::Mutex mutex_;
+  mutable base::CondVar waiters_changed_;  // AwaitWaiters
+  absl::Time now_ ABSL_GUARDED_BY(mutex_);
+  mutable std::vector<Waiter> waiters_ ABSL_GUARDED_BY(mutex_);
 };
 
 }  // namespace fremen::server

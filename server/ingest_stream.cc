@@ -42,7 +42,7 @@ IngestStream::IngestStream(const ServiceDeps& deps, grpc::CallbackServerContext*
 IngestStream* IngestStream::Start(const ServiceDeps& deps, grpc::CallbackServerContext* context) {
   std::shared_ptr<IngestStream> stream(new IngestStream(deps, context));
   stream->self_ = stream;
-  std::lock_guard lock(stream->mutex_);
+  base::MutexLock lock(&stream->mutex_);
   auto id = deps.calls->BeginStream(stream);
   if (!id.ok()) {
     stream->EndLocked(id.status());
@@ -58,7 +58,7 @@ IngestStream* IngestStream::Start(const ServiceDeps& deps, grpc::CallbackServerC
 
 void IngestStream::OnReadDone(bool ok) {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     reading_ = false;
     // The client closed its side: answer what is in flight, then end with OK. Or the call failed
     // (cancelled, a message over the size limit): gRPC has ended it already.
@@ -74,17 +74,17 @@ void IngestStream::OnReadDone(bool ok) {
   absl::Status routed = Parse();
   if (routed.ok()) routed = Route();
   if (!routed.ok()) {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     holding_ = false;
     EndLocked(routed);
     return PumpLocked();
   }
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     held_slot_ = &slots_.emplace_back();
   }
   SubmitHeld();
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   PumpLocked();
 }
 
@@ -125,12 +125,12 @@ void IngestStream::SubmitHeld() {
       self->OnAck(*slot, std::move(ack));
     });
   }
-  std::unique_lock lock(mutex_);
+  base::ReleasableMutexLock lock(&mutex_);
   if (status.ok()) {
     holding_ = false;
   } else if (storage::IsQueueFull(status) && !EndingLocked()) {
     waiting_room_ = true;
-    lock.unlock();
+    lock.Release();
     WaitForRoom(observations);
   } else if (IsBatchError(status)) {
     ErrorToResponse(request_.sequence(), status, slot->response);
@@ -157,7 +157,7 @@ void IngestStream::WaitForRoom(uint64_t observations) {
 
 void IngestStream::RoomAvailable() {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     if (!waiting_room_) return;  // dropped by WindDown
     waiting_room_ = false;
     if (EndingLocked()) {
@@ -167,12 +167,12 @@ void IngestStream::RoomAvailable() {
     }
   }
   SubmitHeld();
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   PumpLocked();
 }
 
 void IngestStream::OnAck(Slot& slot, absl::StatusOr<storage::BatchAck> ack) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (ack.ok()) {
     AckToResponse(*ack, slot.response);
     slot.ready = true;
@@ -189,7 +189,7 @@ void IngestStream::OnAck(Slot& slot, absl::StatusOr<storage::BatchAck> ack) {
 }
 
 void IngestStream::OnWriteDone(bool ok) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   writing_ = false;
   if (ok) {
     slots_.pop_front();
@@ -201,13 +201,13 @@ void IngestStream::OnWriteDone(bool ok) {
 }
 
 void IngestStream::OnCancel() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   cancelled_ = true;
   PumpLocked();
 }
 
 void IngestStream::WindDown() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   EndLocked(absl::UnavailableError(
       "fremend is shutting down; reconnect and resend the batches not acknowledged (repeats are recognised)"));
   if (waiting_room_) {
@@ -222,7 +222,7 @@ void IngestStream::OnDone() {
   if (tracker_id_) deps_.calls->EndStream(*tracker_id_);
   std::shared_ptr<IngestStream> self;
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     self.swap(self_);
   }
   // `self` may be the last owner: the stream is freed here unless the store still holds it.

@@ -37,12 +37,13 @@
 
 #include <deque>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "base/mutex.h"
 #include "absl/time/time.h"
 #include "fremen/v1/ingest.pb.h"
 #include "server/access_log.h"
@@ -64,11 +65,11 @@ class IngestStream final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
   // Starts the call; the reactor frees itself once the call is done and the store is done with it.
   static IngestStream* Start(const ServiceDeps& deps, grpc::CallbackServerContext* context);
 
-  void OnReadDone(bool ok) override;
-  void OnWriteDone(bool ok) override;
-  void OnCancel() override;
-  void OnDone() override;
-  void WindDown() override;
+  void OnReadDone(bool ok) override ABSL_LOCKS_EXCLUDED(mutex_);
+  void OnWriteDone(bool ok) override ABSL_LOCKS_EXCLUDED(mutex_);
+  void OnCancel() override ABSL_LOCKS_EXCLUDED(mutex_);
+  void OnDone() override ABSL_LOCKS_EXCLUDED(mutex_);
+  void WindDown() override ABSL_LOCKS_EXCLUDED(mutex_);
 
  private:
   // One batch's place in the response order.
@@ -87,18 +88,20 @@ class IngestStream final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
   // The map of request_: fixed by the first request, the same for every later one.
   absl::Status Route();
   // Converts and submits the held request (its slot: held_slot_). Called without the lock.
-  void SubmitHeld();
+  void SubmitHeld() ABSL_LOCKS_EXCLUDED(mutex_);
   // After Submit refused the held request for lack of room: resubmit once there is room.
-  void WaitForRoom(uint64_t observations);
+  void WaitForRoom(uint64_t observations) ABSL_LOCKS_EXCLUDED(mutex_);
   // The store has room again: resubmit, unless the stream is ending.
-  void RoomAvailable();
-  void OnAck(Slot& slot, absl::StatusOr<storage::BatchAck> ack);
+  void RoomAvailable() ABSL_LOCKS_EXCLUDED(mutex_);
+  void OnAck(Slot& slot, absl::StatusOr<storage::BatchAck> ack) ABSL_LOCKS_EXCLUDED(mutex_);
   // Ends the stream with `status` once the batches in flight are answered (the first reason wins).
-  void EndLocked(absl::Status status);
-  // Starts what can start now — a write, the finish, a read. REQUIRES: mutex_ held.
-  void PumpLocked();
-  void FinishLocked(const absl::Status& status);
-  bool EndingLocked() const { return end_status_.has_value() || cancelled_ || finished_; }
+  void EndLocked(absl::Status status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // Starts what can start now — a write, the finish, a read.
+  void PumpLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  void FinishLocked(const absl::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  bool EndingLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_) {
+    return end_status_.has_value() || cancelled_ || finished_;
+  }
 
   const ServiceDeps deps_;
   grpc::CallbackServerContext* const context_;
@@ -113,18 +116,23 @@ class IngestStream final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
   grpc::ByteBuffer message_;   // gRPC's while reading_, the stream's while holding_
   v1::IngestRequest request_;  // parsed from message_; the stream's while holding_
   uint64_t messages_ = 0;      // read so far, for errors naming a message's position
-
-  std::mutex mutex_;
-  std::deque<Slot> slots_;  // unanswered batches, in order; references stay valid at both ends
+  // The slot of request_ while holding_ (set under the mutex with the slot's creation).
   Slot* held_slot_ = nullptr;
-  bool reading_ = false;       // a StartRead is outstanding
-  bool holding_ = false;       // request_ holds a batch not yet in the store
-  bool waiting_room_ = false;  // ... because the store's queue is full
-  bool writing_ = false;       // a StartWrite is outstanding (of slots_.front())
-  bool cancelled_ = false;
-  bool finished_ = false;
-  std::optional<absl::Status> end_status_;
-  uint64_t answered_ = 0, accepted_ = 0, rejected_ = 0;  // for the access log
+
+  base::Mutex mutex_;
+  // Unanswered batches, in order; references stay valid at both ends.
+  std::deque<Slot> slots_ ABSL_GUARDED_BY(mutex_);
+  bool reading_ ABSL_GUARDED_BY(mutex_) = false;       // a StartRead is outstanding
+  bool holding_ ABSL_GUARDED_BY(mutex_) = false;       // request_ holds a batch not yet in the store
+  bool waiting_room_ ABSL_GUARDED_BY(mutex_) = false;  // ... because the store's queue is full
+  bool writing_ ABSL_GUARDED_BY(mutex_) = false;       // a StartWrite is outstanding (of slots_.front())
+  bool cancelled_ ABSL_GUARDED_BY(mutex_) = false;
+  bool finished_ ABSL_GUARDED_BY(mutex_) = false;
+  std::optional<absl::Status> end_status_ ABSL_GUARDED_BY(mutex_);
+  // For the access log.
+  uint64_t answered_ ABSL_GUARDED_BY(mutex_) = 0;
+  uint64_t accepted_ ABSL_GUARDED_BY(mutex_) = 0;
+  uint64_t rejected_ ABSL_GUARDED_BY(mutex_) = 0;
 };
 
 }  // namespace fremen::server

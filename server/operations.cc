@@ -28,7 +28,7 @@ OperationRegistry::OperationRegistry(UpdateJob job, const Clock& clock, Options 
     : job_(std::move(job)), clock_(clock), options_(options), thread_([this] { Run(); }) {}
 
 absl::StatusOr<OperationView> OperationRegistry::StartUpdate(const std::string& map, absl::string_view trigger) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (stopping_) return absl::UnavailableError("fremend is stopping; no new operations");
   if (auto active = active_by_map_.find(map); active != active_by_map_.end()) {
     return operations_.at(active->second).view;  // idempotent: the update already under way
@@ -45,7 +45,7 @@ absl::StatusOr<OperationView> OperationRegistry::StartUpdate(const std::string& 
   by_name_[op.view.name] = id;
   active_by_map_[map] = id;
   queue_.push_back(id);
-  work_.notify_one();
+  work_.Signal();
   return op.view;
 }
 
@@ -55,7 +55,7 @@ const OperationRegistry::Operation* OperationRegistry::FindLocked(const std::str
 }
 
 absl::StatusOr<OperationView> OperationRegistry::Get(const std::string& name) const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   const Operation* op = FindLocked(name);
   if (op == nullptr) {
     return absl::NotFoundError(absl::StrCat("no operation named \"", name, "\" (finished ones are kept for ",
@@ -75,7 +75,7 @@ absl::StatusOr<OperationRegistry::Page> OperationRegistry::List(const std::strin
         absl::StrCat("page_token: \"", page_token, "\" is not a next_page_token of ListOperations"));
   }
   Page page;
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   for (auto it = operations_.lower_bound(before); it != operations_.begin();) {
     const OperationView& view = (--it)->second.view;
     if (!map.empty() && view.map != map) continue;
@@ -90,7 +90,7 @@ absl::StatusOr<OperationRegistry::Page> OperationRegistry::List(const std::strin
 }
 
 absl::StatusOr<OperationView> OperationRegistry::Cancel(const std::string& name) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   auto it = by_name_.find(name);
   if (it == by_name_.end()) {
     return absl::NotFoundError(absl::StrCat("no operation named \"", name, "\""));
@@ -118,12 +118,12 @@ absl::StatusOr<OperationView> OperationRegistry::Cancel(const std::string& name)
 }
 
 size_t OperationRegistry::running() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   return active_by_map_.size();
 }
 
 std::vector<OperationView> OperationRegistry::LastUpdates() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   absl::flat_hash_map<std::string, const OperationView*> last;
   for (const auto& [id, op] : operations_) {  // oldest first: later ones replace earlier ones
     if (op.view.done()) last[op.view.map] = &op.view;
@@ -136,33 +136,34 @@ std::vector<OperationView> OperationRegistry::LastUpdates() const {
 
 void OperationRegistry::Stop() {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     if (stopping_ && !thread_.joinable()) return;
     stopping_ = true;
     for (uint64_t id : queue_) FinishLocked(operations_.at(id), absl::CancelledError("fremend stopped before it started"));
     queue_.clear();
-    work_.notify_all();
+    work_.SignalAll();
   }
   if (thread_.joinable()) thread_.join();
 }
 
 void OperationRegistry::Run() {
-  std::unique_lock lock(mutex_);
   while (true) {
-    work_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
-    if (queue_.empty()) return;  // stopping, nothing left
-    const uint64_t id = queue_.front();
-    queue_.erase(queue_.begin());
-    lock.unlock();
+    uint64_t id;
+    {
+      base::MutexLock lock(&mutex_);
+      while (!stopping_ && queue_.empty()) work_.Wait(&mutex_);
+      if (queue_.empty()) return;  // stopping, nothing left
+      id = queue_.front();
+      queue_.erase(queue_.begin());
+    }
     RunOne(id);
-    lock.lock();
   }
 }
 
 void OperationRegistry::RunOne(uint64_t id) {
   std::string map;
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     Operation& op = operations_.at(id);
     op.view.stage = OperationStage::kRunning;
     op.view.start_time = clock_.Now();
@@ -172,7 +173,7 @@ void OperationRegistry::RunOne(uint64_t id) {
   }
   JobControl control(this, id, map);
   absl::StatusOr<UpdateFigures> outcome = job_(control);
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   Operation& op = operations_.at(id);
   if (op.view.stage != OperationStage::kPublishing && !outcome.ok() && op.view.cancel_requested) {
     outcome = absl::CancelledError("cancelled before it published");
@@ -181,7 +182,7 @@ void OperationRegistry::RunOne(uint64_t id) {
 }
 
 bool OperationRegistry::BeginPublishing(uint64_t id) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   Operation& op = operations_.at(id);
   if (op.view.cancel_requested || stopping_) {
     op.view.cancel_requested = true;
@@ -194,7 +195,7 @@ bool OperationRegistry::BeginPublishing(uint64_t id) {
 }
 
 void OperationRegistry::Progress(uint64_t id, uint64_t done, uint64_t total) {
-  std::unique_lock lock(mutex_);
+  base::ReleasableMutexLock lock(&mutex_);
   Operation& op = operations_.at(id);
   const absl::Time now = clock_.Now();
   OperationView& view = op.view;
@@ -210,7 +211,7 @@ void OperationRegistry::Progress(uint64_t id, uint64_t done, uint64_t total) {
   const std::string line =
       absl::StrFormat("update of map %s: %d/%d states (%.0f%%), %.3g states/s, ~%.3g s left", view.map, done, total,
                       total > 0 ? 100.0 * done / total : 100.0, view.rate, view.eta_seconds);
-  lock.unlock();
+  lock.Release();
   DaemonLog()->info("{}", line);
 }
 

@@ -20,20 +20,20 @@
 // Thread-safety: every public method may be called from any thread.
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "base/mutex.h"
 #include "absl/time/time.h"
 #include "server/clock.h"
 
@@ -123,24 +123,25 @@ class OperationRegistry {
 
   // Queues an update of `map`, or returns the update of `map` not yet done. Unavailable once
   // stopping. The caller checks that the map exists.
-  absl::StatusOr<OperationView> StartUpdate(const std::string& map, absl::string_view trigger);
+  absl::StatusOr<OperationView> StartUpdate(const std::string& map, absl::string_view trigger)
+      ABSL_LOCKS_EXCLUDED(mutex_);
   // NotFound for a name never given or no longer kept.
-  absl::StatusOr<OperationView> Get(const std::string& name) const;
+  absl::StatusOr<OperationView> Get(const std::string& name) const ABSL_LOCKS_EXCLUDED(mutex_);
   // Newest first; `map` empty = every map. `page_token` is a next_page_token of an earlier page
   // (InvalidArgument otherwise); page_size > 0.
   absl::StatusOr<Page> List(const std::string& map, bool running_only, size_t page_size,
-                            const std::string& page_token) const;
+                            const std::string& page_token) const ABSL_LOCKS_EXCLUDED(mutex_);
   // See the file comment. NotFound as Get; an operation already done is returned unchanged.
-  absl::StatusOr<OperationView> Cancel(const std::string& name);
+  absl::StatusOr<OperationView> Cancel(const std::string& name) ABSL_LOCKS_EXCLUDED(mutex_);
 
   // Operations not yet done.
-  size_t running() const;
+  size_t running() const ABSL_LOCKS_EXCLUDED(mutex_);
   // For each map, its most recent finished update still kept.
-  std::vector<OperationView> LastUpdates() const;
+  std::vector<OperationView> LastUpdates() const ABSL_LOCKS_EXCLUDED(mutex_);
 
   // Refuses new operations, cancels the queued ones, lets the running one finish (a publication
   // is short and atomic; a job not yet publishing is cancelled) and joins the thread. Idempotent.
-  void Stop();
+  void Stop() ABSL_LOCKS_EXCLUDED(mutex_);
 
  private:
   friend class JobControl;
@@ -150,28 +151,30 @@ class OperationRegistry {
     absl::Time last_log = absl::InfinitePast();
   };
 
-  void Run();
-  void RunOne(uint64_t id);
-  bool BeginPublishing(uint64_t id);
-  void Progress(uint64_t id, uint64_t done, uint64_t total);
-  // Ends an operation; REQUIRES: mutex_ held.
-  void FinishLocked(Operation& op, absl::StatusOr<UpdateFigures> outcome);
-  // Drops finished operations beyond the limits; REQUIRES: mutex_ held.
-  void PruneLocked();
-  const Operation* FindLocked(const std::string& name) const;
+  void Run() ABSL_LOCKS_EXCLUDED(mutex_);
+  // Runs the job without the lock: the registry answers polls while it runs.
+  void RunOne(uint64_t id) ABSL_LOCKS_EXCLUDED(mutex_);
+  bool BeginPublishing(uint64_t id) ABSL_LOCKS_EXCLUDED(mutex_);
+  void Progress(uint64_t id, uint64_t done, uint64_t total) ABSL_LOCKS_EXCLUDED(mutex_);
+  // Ends an operation.
+  void FinishLocked(Operation& op, absl::StatusOr<UpdateFigures> outcome) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // Drops finished operations beyond the limits.
+  void PruneLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  const Operation* FindLocked(const std::string& name) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
 
   const UpdateJob job_;
   const Clock& clock_;
   const Options options_;
 
-  mutable std::mutex mutex_;
-  std::condition_variable work_;
-  std::map<uint64_t, Operation> operations_;  // by id: oldest first
-  absl::flat_hash_map<std::string, uint64_t> by_name_;
-  absl::flat_hash_map<std::string, uint64_t> active_by_map_;  // the update not yet done, per map
-  std::vector<uint64_t> queue_;                               // queued ids, oldest first
-  uint64_t next_id_ = 1;
-  bool stopping_ = false;
+  mutable base::Mutex mutex_;
+  base::CondVar work_;
+  std::map<uint64_t, Operation> operations_ ABSL_GUARDED_BY(mutex_);  // by id: oldest first
+  absl::flat_hash_map<std::string, uint64_t> by_name_ ABSL_GUARDED_BY(mutex_);
+  // The update not yet done, per map.
+  absl::flat_hash_map<std::string, uint64_t> active_by_map_ ABSL_GUARDED_BY(mutex_);
+  std::vector<uint64_t> queue_ ABSL_GUARDED_BY(mutex_);  // queued ids, oldest first
+  uint64_t next_id_ ABSL_GUARDED_BY(mutex_) = 1;
+  bool stopping_ ABSL_GUARDED_BY(mutex_) = false;
   std::thread thread_;
 };
 

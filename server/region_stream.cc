@@ -37,7 +37,7 @@ RegionStream* RegionStream::Start(const ServiceDeps& deps, grpc::CallbackServerC
   if (status.ok()) status = stream->Prepare(request);
   if (!status.ok()) {
     {
-      std::lock_guard lock(stream->mutex_);  // OnCancel may already pump
+      base::MutexLock lock(&stream->mutex_);  // OnCancel may already pump
       stream->finished_ = true;
     }
     stream->FinishWith(status);
@@ -92,7 +92,7 @@ void RegionStream::Pump() {
   std::optional<uint64_t> to_compute;
   std::optional<absl::Status> to_finish;
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     if (finished_) return;
     if (error_.ok()) error_ = Interrupted();
     const bool all_sent = next_block_ == blocks_->chunk_count() && ready_.empty();
@@ -124,7 +124,7 @@ void RegionStream::Pump() {
   }
   if (!deps_.blocking->Post([this, i = *to_compute] { Compute(i); })) {
     {
-      std::lock_guard lock(mutex_);
+      base::MutexLock lock(&mutex_);
       computing_ = false;
       error_ = absl::ResourceExhaustedError("fremend is busy (too many calls waiting); retry PredictRegion later");
     }
@@ -134,7 +134,7 @@ void RegionStream::Pump() {
 
 std::unique_ptr<v1::PredictRegionResponse> RegionStream::TakeBuffer() {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     if (!free_.empty()) {
       std::unique_ptr<Response> buffer = std::move(free_.back());
       free_.pop_back();
@@ -164,7 +164,7 @@ void RegionStream::Compute(uint64_t i) {
     }
   }
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     computing_ = false;
     if (!status.ok() && error_.ok()) error_ = status;
     for (auto& chunk : chunks) ready_.push_back(std::move(chunk));
@@ -174,7 +174,7 @@ void RegionStream::Compute(uint64_t i) {
 
 void RegionStream::OnWriteDone(bool ok) {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     writing_ = false;
     cells_sent_ += in_flight_->float_values_size() + in_flight_->bytes_values().size();
     free_.push_back(std::move(in_flight_));

@@ -22,11 +22,12 @@
 #include <atomic>
 #include <deque>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
+#include "base/mutex.h"
 #include "fremen/v1/query.pb.h"
 #include "server/access_log.h"
 #include "server/region_plan.h"
@@ -41,8 +42,8 @@ class RegionStream final : public grpc::ServerWriteReactor<v1::PredictRegionResp
   static RegionStream* Start(const ServiceDeps& deps, grpc::CallbackServerContext* context,
                              const v1::PredictRegionRequest& request);
 
-  void OnWriteDone(bool ok) override;
-  void OnCancel() override;
+  void OnWriteDone(bool ok) override ABSL_LOCKS_EXCLUDED(mutex_);
+  void OnCancel() override ABSL_LOCKS_EXCLUDED(mutex_);
   void OnDone() override;
 
  private:
@@ -52,10 +53,10 @@ class RegionStream final : public grpc::ServerWriteReactor<v1::PredictRegionResp
   // Checks the request and plans the chunks.
   absl::Status Prepare(const v1::PredictRegionRequest& request);
   // Decides, under the mutex, what comes next — a write, a computation, or the end — and does it.
-  void Pump();
+  void Pump() ABSL_LOCKS_EXCLUDED(mutex_);
   // Computes block i and queues its chunks, then pumps.
-  void Compute(uint64_t i);
-  std::unique_ptr<Response> TakeBuffer();
+  void Compute(uint64_t i) ABSL_LOCKS_EXCLUDED(mutex_);
+  std::unique_ptr<Response> TakeBuffer() ABSL_LOCKS_EXCLUDED(mutex_);
   // Why the stream must stop now (cancelled, past its deadline), or OK.
   absl::Status Interrupted() const;
   void FinishWith(const absl::Status& status);
@@ -83,16 +84,17 @@ class RegionStream final : public grpc::ServerWriteReactor<v1::PredictRegionResp
 
   std::vector<float> scratch_;  // the computing thread's (one at a time)
 
-  std::mutex mutex_;
-  absl::Status error_;
-  uint64_t next_block_ = 0;  // the next to compute
+  base::Mutex mutex_;
+  absl::Status error_ ABSL_GUARDED_BY(mutex_);
+  uint64_t next_block_ ABSL_GUARDED_BY(mutex_) = 0;  // the next to compute
   std::atomic<uint64_t> cells_sent_{0};  // read by Interrupted() outside the mutex
-  bool computing_ = false;
-  bool writing_ = false;
-  bool finished_ = false;
-  std::deque<std::unique_ptr<Response>> ready_;  // chunks computed, in order, not yet written
-  std::unique_ptr<Response> in_flight_;
-  std::vector<std::unique_ptr<Response>> free_;
+  bool computing_ ABSL_GUARDED_BY(mutex_) = false;
+  bool writing_ ABSL_GUARDED_BY(mutex_) = false;
+  bool finished_ ABSL_GUARDED_BY(mutex_) = false;
+  // Chunks computed, in order, not yet written.
+  std::deque<std::unique_ptr<Response>> ready_ ABSL_GUARDED_BY(mutex_);
+  std::unique_ptr<Response> in_flight_ ABSL_GUARDED_BY(mutex_);
+  std::vector<std::unique_ptr<Response>> free_ ABSL_GUARDED_BY(mutex_);
 };
 
 }  // namespace fremen::server

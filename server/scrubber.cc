@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
@@ -35,7 +34,7 @@ Scrubber::Scrubber(Options options, const Clock& clock, MapLister list_maps, Che
     : options_(options), clock_(clock), list_maps_(std::move(list_maps)), check_(std::move(check)) {}
 
 void Scrubber::Start() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (!enabled()) {
     DaemonLog()->info("no background scrub (scrub_interval 0): maps are checked only on demand (CheckMap)");
     return;
@@ -48,21 +47,21 @@ void Scrubber::Start() {
 
 void Scrubber::Stop() {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     stopping_ = true;
     next_ = absl::InfiniteFuture();
-    wake_.notify_all();
+    wake_.SignalAll();
   }
   if (thread_.joinable()) thread_.join();
 }
 
 absl::Time Scrubber::NextPass() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   return next_;
 }
 
 std::vector<Scrubber::Result> Scrubber::Results() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   std::vector<Result> results;
   results.reserve(results_.size());
   for (const auto& [map, result] : results_) results.push_back(result);
@@ -70,23 +69,27 @@ std::vector<Scrubber::Result> Scrubber::Results() const {
 }
 
 bool Scrubber::AwaitPasses(uint64_t passes, absl::Duration timeout) const {
-  std::unique_lock lock(mutex_);
-  return pass_done_.wait_for(lock, absl::ToChronoNanoseconds(timeout), [&] { return passes_ >= passes; });
+  const absl::Time deadline = absl::Now() + timeout;
+  base::MutexLock lock(&mutex_);
+  while (passes_ < passes) {
+    if (pass_done_.WaitWithDeadline(&mutex_, deadline)) return passes_ >= passes;  // timed out
+  }
+  return true;
 }
 
 void Scrubber::Run() {
   if (options_.low_priority) LowerThisThreadsPriority();
-  std::unique_lock lock(mutex_);
+  base::MutexLock lock(&mutex_);
   while (!stopping_) {
     if (clock_.Now() < next_) {
-      clock_.WaitUntil(wake_, lock, next_);
+      clock_.WaitUntil(wake_, mutex_, next_);
       continue;
     }
-    lock.unlock();
+    mutex_.Unlock();
     Pass();
-    lock.lock();
+    mutex_.Lock();
     ++passes_;
-    pass_done_.notify_all();
+    pass_done_.SignalAll();
     // From the end of this pass: a pass that takes longer than the interval is not followed at once
     // by the next one.
     if (!stopping_) next_ = clock_.Now() + options_.interval;
@@ -100,14 +103,14 @@ void Scrubber::Pass() {
     return;
   }
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     for (auto it = results_.begin(); it != results_.end();) {
       it = std::find(maps->begin(), maps->end(), it->first) == maps->end() ? results_.erase(it) : std::next(it);
     }
   }
   for (const std::string& map : *maps) {
     {
-      std::lock_guard lock(mutex_);
+      base::MutexLock lock(&mutex_);
       if (stopping_) return;
     }
     Scrub(map);
@@ -138,7 +141,7 @@ void Scrubber::Scrub(const std::string& map) {
     DaemonLog()->error("scrub of map {}: {} problems, first {}", map, result.problem_count,
                        storage::FormatProblem(report->problems.front()));
   }
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   results_[map] = std::move(result);
 }
 

@@ -13,16 +13,16 @@
 // Thread-safety: Start and Stop from one thread; Results, NextPass, AwaitPasses from any thread.
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/btree_map.h"
 #include "absl/status/statusor.h"
+#include "base/mutex.h"
 #include "absl/time/time.h"
 #include "server/clock.h"
 #include "storage/verify.h"
@@ -61,37 +61,38 @@ class Scrubber {
   Scrubber& operator=(const Scrubber&) = delete;
 
   // Starts the thread; does nothing when the interval is 0.
-  void Start();
+  void Start() ABSL_LOCKS_EXCLUDED(mutex_);
   // Stops and joins the thread; a pass under way stops after the map it is verifying. Idempotent.
-  void Stop();
+  void Stop() ABSL_LOCKS_EXCLUDED(mutex_);
 
   bool enabled() const { return options_.interval > absl::ZeroDuration(); }
   // When the next pass starts; InfiniteFuture when off or stopped.
-  absl::Time NextPass() const;
+  absl::Time NextPass() const ABSL_LOCKS_EXCLUDED(mutex_);
   // Each map's latest result, in map name order (maps no longer listed are dropped at each pass).
-  std::vector<Result> Results() const;
+  std::vector<Result> Results() const ABSL_LOCKS_EXCLUDED(mutex_);
   // Waits until `passes` passes have finished since Start, or `timeout` (real time) has passed;
   // returns whether they have. For tests, which move a fake clock and then wait for the thread.
-  bool AwaitPasses(uint64_t passes, absl::Duration timeout) const;
+  bool AwaitPasses(uint64_t passes, absl::Duration timeout) const ABSL_LOCKS_EXCLUDED(mutex_);
 
  private:
-  void Run();
-  void Pass();
-  void Scrub(const std::string& map);
+  void Run() ABSL_LOCKS_EXCLUDED(mutex_);
+  // Both called without the lock: a pass takes long, and NextPass/Results answer meanwhile.
+  void Pass() ABSL_LOCKS_EXCLUDED(mutex_);
+  void Scrub(const std::string& map) ABSL_LOCKS_EXCLUDED(mutex_);
 
   const Options options_;
   const Clock& clock_;
   const MapLister list_maps_;
   const Check check_;
 
-  mutable std::mutex mutex_;
-  mutable std::condition_variable wake_;      // Stop, the clock
-  mutable std::condition_variable pass_done_;  // AwaitPasses
-  absl::Time next_ = absl::InfiniteFuture();
-  uint64_t passes_ = 0;
-  bool stopping_ = false;
-  absl::btree_map<std::string, Result> results_;
-  std::thread thread_;
+  mutable base::Mutex mutex_;
+  mutable base::CondVar wake_;       // Stop, the clock
+  mutable base::CondVar pass_done_;  // AwaitPasses
+  absl::Time next_ ABSL_GUARDED_BY(mutex_) = absl::InfiniteFuture();
+  uint64_t passes_ ABSL_GUARDED_BY(mutex_) = 0;
+  bool stopping_ ABSL_GUARDED_BY(mutex_) = false;
+  absl::btree_map<std::string, Result> results_ ABSL_GUARDED_BY(mutex_);
+  std::thread thread_;  // Start and Stop's (one thread)
 };
 
 }  // namespace fremen::server

@@ -27,7 +27,7 @@ UpdateScheduler::UpdateScheduler(Options options, const Clock& clock, MapLister 
 }
 
 void UpdateScheduler::Start() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (entries_.empty() || thread_.joinable() || stopping_) {
     if (entries_.empty()) DaemonLog()->info("no update schedule: updates run only on demand (RunUpdate)");
     return;
@@ -41,15 +41,15 @@ void UpdateScheduler::Start() {
 
 void UpdateScheduler::Stop() {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     stopping_ = true;
-    wake_.notify_all();
+    wake_.SignalAll();
   }
   if (thread_.joinable()) thread_.join();
 }
 
 absl::Time UpdateScheduler::NextRun() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   return NextRunLocked();
 }
 
@@ -60,42 +60,39 @@ absl::Time UpdateScheduler::NextRunLocked() const {
 }
 
 void UpdateScheduler::Run() {
-  std::unique_lock lock(mutex_);
+  base::MutexLock lock(&mutex_);
   while (!stopping_) {
     const absl::Time now = clock_.Now();
-    std::vector<bool> due(entries_.size(), false);
-    bool any = false;
-    for (size_t i = 0; i < entries_.size(); ++i) {
-      if (entries_[i].next > now) continue;
-      due[i] = any = true;
+    std::vector<std::string> due;
+    for (Entry& entry : entries_) {
+      if (entry.next > now) continue;
+      due.push_back(entry.map);
       // From now, not from the run that was due: a jump over several runs gives one.
-      entries_[i].next = entries_[i].schedule.Next(now, options_.zone);
+      entry.next = entry.schedule.Next(now, options_.zone);
     }
-    if (any) {
-      lock.unlock();
+    if (!due.empty()) {
+      mutex_.Unlock();
       Fire(due);
-      lock.lock();
+      mutex_.Lock();
       DaemonLog()->info("next scheduled update {}", Format(NextRunLocked(), options_.zone));
       continue;
     }
-    clock_.WaitUntil(wake_, lock, NextRunLocked());
+    clock_.WaitUntil(wake_, mutex_, NextRunLocked());
   }
 }
 
-void UpdateScheduler::Fire(const std::vector<bool>& due) {
+void UpdateScheduler::Fire(const std::vector<std::string>& due) {
   auto maps = list_maps_();
   if (!maps.ok()) {
     DaemonLog()->warn("scheduled update skipped: cannot list the maps: {}", std::string(maps.status().message()));
     return;
   }
-  const bool default_due = options_.schedule && due[0];
+  const auto is_due = [&](const std::string& map) { return std::find(due.begin(), due.end(), map) != due.end(); };
+  const bool default_due = options_.schedule && is_due("");
   size_t started = 0;
   for (const std::string& map : *maps) {
     bool run = default_due;
-    if (auto o = options_.overrides.find(map); o != options_.overrides.end()) {
-      run = false;
-      for (size_t i = 0; i < entries_.size(); ++i) run = run || (due[i] && entries_[i].map == map);
-    }
+    if (auto o = options_.overrides.find(map); o != options_.overrides.end()) run = is_due(map);
     if (!run) continue;
     trigger_(map);
     ++started;

@@ -14,16 +14,16 @@
 // the scheduler's thread and must not block for long.
 #pragma once
 
-#include <condition_variable>
 #include <functional>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
+#include "base/mutex.h"
 #include "absl/time/time.h"
 #include "server/clock.h"
 #include "server/config.h"
@@ -51,12 +51,12 @@ class UpdateScheduler {
   UpdateScheduler& operator=(const UpdateScheduler&) = delete;
 
   // Starts the thread; nothing runs before. A scheduler with no schedule at all starts none.
-  void Start();
+  void Start() ABSL_LOCKS_EXCLUDED(mutex_);
   // Stops and joins the thread. Idempotent.
-  void Stop();
+  void Stop() ABSL_LOCKS_EXCLUDED(mutex_);
 
   // The next time any map's update is due; InfiniteFuture when none is scheduled.
-  absl::Time NextRun() const;
+  absl::Time NextRun() const ABSL_LOCKS_EXCLUDED(mutex_);
 
  private:
   // One schedule and its next run: the default one (map empty) or a map's override.
@@ -66,21 +66,22 @@ class UpdateScheduler {
     absl::Time next;
   };
 
-  void Run();
-  // Starts the updates of the entries that are due; called without the lock.
-  void Fire(const std::vector<bool>& due);
-  absl::Time NextRunLocked() const;
+  void Run() ABSL_LOCKS_EXCLUDED(mutex_);
+  // Starts the updates of the due entries, named by their maps ("" for the default schedule).
+  // Called without the lock: the lister and the triggers may take long.
+  void Fire(const std::vector<std::string>& due) ABSL_LOCKS_EXCLUDED(mutex_);
+  absl::Time NextRunLocked() const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
 
   const Options options_;
   const Clock& clock_;
   const MapLister list_maps_;
   const Trigger trigger_;
 
-  mutable std::mutex mutex_;
-  std::condition_variable wake_;
-  std::vector<Entry> entries_;
-  bool stopping_ = false;
-  std::thread thread_;
+  mutable base::Mutex mutex_;
+  base::CondVar wake_;
+  std::vector<Entry> entries_ ABSL_GUARDED_BY(mutex_);
+  bool stopping_ ABSL_GUARDED_BY(mutex_) = false;
+  std::thread thread_;  // Start and Stop's (one thread)
 };
 
 // The schedules from the config (update_schedule, update_time_zone, update_map_schedules).

@@ -93,7 +93,8 @@ absl::Status MapStore::Recover() {
     newest = std::max(newest, shard->checkpoint_lsn());
     dedup_.MergeFrom(shard->checkpoint_dedup());
   }
-  auto replayed = ReplayWal(dir_ + "/wal", from, [&](uint64_t lsn, std::span<const uint8_t> payload) -> absl::Status {
+  auto replayed = ReplayWal(dir_ + "/wal", from, [&](uint64_t lsn, std::span<const uint8_t> payload)
+                                                     ABSL_NO_THREAD_SAFETY_ANALYSIS -> absl::Status {  // see Recover
     if (payload.size() == 1 && payload[0] == kPublishRecord) {
       for (const auto& shard : shards_) {
         if (shard->checkpoint_lsn() < lsn) shard->PublishAll();
@@ -143,7 +144,7 @@ absl::Status MapStore::Recover() {
   applied_dedup_ = dedup_;
   applied_lsn_ = wal_->last_lsn();
   for (const auto& shard : shards_) {
-    shard->ForEachLabel([&](uint64_t key, const std::string&, const std::string& group) {
+    shard->ForEachLabel([&](uint64_t key, const std::string&, const std::string& group) ABSL_NO_THREAD_SAFETY_ANALYSIS {
       if (!group.empty()) groups_[group].push_back(key);
     });
   }
@@ -197,7 +198,7 @@ absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
                                                    info_.lossless_origin, ", got ", batch.time));
   }
   const uint64_t n = batch.observation_count();
-  const auto refusal = [&]() -> absl::Status {
+  const auto refusal = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(queue_mutex_) -> absl::Status {
     if (closing_) return absl::UnavailableError(absl::StrCat("map ", info_.name, " is closing"));
     if (!write_error_.ok()) return write_error_;
     if (!FitsLocked(n)) {
@@ -211,23 +212,23 @@ absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
   {
     // Checked before the batch is prepared, so that a refusal costs nothing; again after, since
     // the queue may have filled meanwhile.
-    std::lock_guard lock(queue_mutex_);
+    base::MutexLock lock(&queue_mutex_);
     if (absl::Status refused = refusal(); !refused.ok()) return refused;
   }
   Pending pending = Prepare(std::move(batch), std::move(done));
   {
-    std::lock_guard lock(queue_mutex_);
+    base::MutexLock lock(&queue_mutex_);
     if (absl::Status refused = refusal(); !refused.ok()) return refused;
     queued_observations_ += n;
     queue_.push_back(std::move(pending));
   }
-  queue_ready_.notify_one();
+  queue_ready_.Signal();
   return absl::OkStatus();
 }
 
 void MapStore::OnRoom(uint64_t observations, std::function<void()> f) {
   {
-    std::lock_guard lock(queue_mutex_);
+    base::MutexLock lock(&queue_mutex_);
     if (!FitsLocked(observations) && !closing_ && write_error_.ok()) {
       room_waiters_.push_back(std::move(f));
       return;
@@ -249,7 +250,7 @@ absl::StatusOr<BatchAck> MapStore::Write(ObservationBatch batch) {
 }
 
 uint64_t MapStore::LastSequence(uint64_t writer) const {
-  std::lock_guard lock(dedup_mutex_);
+  base::MutexLock lock(&dedup_mutex_);
   return dedup_.LastSequence(writer);
 }
 
@@ -257,12 +258,12 @@ absl::StatusOr<uint64_t> MapStore::RunControl(Control::Kind kind, std::function<
   std::promise<absl::StatusOr<uint64_t>> promise;
   auto future = promise.get_future();
   {
-    std::lock_guard lock(queue_mutex_);
+    base::MutexLock lock(&queue_mutex_);
     if (!committer_.joinable() || closing_) return absl::UnavailableError(absl::StrCat("map ", info_.name, " is closed"));
     controls_.push_back(
         {kind, [&](absl::StatusOr<uint64_t> r) { promise.set_value(std::move(r)); }, std::move(progress)});
   }
-  queue_ready_.notify_one();
+  queue_ready_.Signal();
   return future.get();
 }
 
@@ -273,7 +274,7 @@ absl::StatusOr<uint64_t> MapStore::PublishModels(std::function<void(uint64_t, ui
 }
 
 absl::Status MapStore::RecordUpdate(const UpdateRecord& record) {
-  std::lock_guard lock(last_update_mutex_);
+  base::MutexLock lock(&last_update_mutex_);
   if (absl::Status s = WriteUpdateRecord(options_.env, LastUpdatePath(dir_), record); !s.ok()) return s;
   last_update_ = record;
   return absl::OkStatus();
@@ -281,26 +282,26 @@ absl::Status MapStore::RecordUpdate(const UpdateRecord& record) {
 
 absl::Status MapStore::Close() {
   {
-    std::lock_guard lock(queue_mutex_);
+    base::MutexLock lock(&queue_mutex_);
     closing_ = true;
   }
-  queue_ready_.notify_one();
+  queue_ready_.Signal();
   if (committer_.joinable()) committer_.join();
   if (applier_.joinable()) applier_.join();
   WaitCheckpointWrite();  // the applier waits for it before it ends; the applier is gone now
-  std::lock_guard lock(queue_mutex_);
+  base::MutexLock lock(&queue_mutex_);
   return write_error_;
 }
 
 absl::Status MapStore::WriteError() const {
-  std::lock_guard lock(queue_mutex_);
+  base::MutexLock lock(&queue_mutex_);
   return write_error_;
 }
 
 void MapStore::Latch(const absl::Status& status) {
   std::vector<std::function<void()>> room;
   {
-    std::lock_guard lock(queue_mutex_);
+    base::MutexLock lock(&queue_mutex_);
     if (!write_error_.ok()) return;
     // A full disk stays ResourceExhausted; any other fault (an I/O error) is Unavailable: the map
     // takes no writes until an operator fixes the cause and reopens it. The message keeps the cause.
@@ -324,8 +325,8 @@ void MapStore::CommitLoop() {
     std::vector<std::function<void()>> room;
     bool closing;
     {
-      std::unique_lock lock(queue_mutex_);
-      queue_ready_.wait(lock, [&] { return !queue_.empty() || closing_ || !controls_.empty(); });
+      base::MutexLock lock(&queue_mutex_);
+      while (queue_.empty() && !closing_ && controls_.empty()) queue_ready_.Wait(&queue_mutex_);
       while (!queue_.empty()) {
         queued_observations_ -= queue_.front().batch.observation_count();
         stage.group.push_back(std::move(queue_.front()));
@@ -339,12 +340,12 @@ void MapStore::CommitLoop() {
     stage.final = closing && stage.group.empty();
     absl::Status status;
     {
-      std::lock_guard lock(queue_mutex_);
+      base::MutexLock lock(&queue_mutex_);
       status = write_error_;
     }
     // 1. Log the new batches and publications, then sync once for all of them (group commit).
     if (status.ok()) {
-      std::lock_guard wal(wal_mutex_);
+      base::MutexLock wal(&wal_mutex_);
       LogGroup(stage.group);
       stage.group_lsn = wal_->last_lsn();
       for (Control& c : stage.controls) {
@@ -371,17 +372,17 @@ void MapStore::CommitLoop() {
     // yet applied (and so acknowledged late).
     const bool final = stage.final;
     {
-      std::unique_lock lock(stage_mutex_);
-      stage_changed_.wait(lock, [&] { return stages_.empty(); });
+      base::MutexLock lock(&stage_mutex_);
+      while (!stages_.empty()) stage_changed_.Wait(&stage_mutex_);
       stages_.push_back(std::move(stage));
     }
-    stage_changed_.notify_all();
+    stage_changed_.SignalAll();
     if (final) return;
   }
 }
 
 void MapStore::LogGroup(std::vector<Pending>& group) {
-  std::lock_guard lock(dedup_mutex_);
+  base::MutexLock lock(&dedup_mutex_);
   for (Pending& p : group) {
     const absl::StatusOr<bool> seen = dedup_.Seen(p.batch.writer_id, p.batch.sequence, p.fingerprint);
     if (!seen.ok() || *seen) {
@@ -403,18 +404,18 @@ void MapStore::ApplyLoop() {
   for (;;) {
     Stage stage;
     {
-      std::unique_lock lock(stage_mutex_);
+      base::ReleasableMutexLock lock(&stage_mutex_);
       if (publication_.has_value() && stages_.empty() && !publication_held_) {
         // Publish a slice, then look for batches again: they wait at most one slice.
-        lock.unlock();
+        lock.Release();
         ContinuePublication();
         continue;
       }
-      stage_changed_.wait(lock, [&] { return !stages_.empty(); });
+      while (stages_.empty()) stage_changed_.Wait(&stage_mutex_);
       stage = std::move(stages_.front());
       stages_.pop_front();
     }
-    stage_changed_.notify_all();
+    stage_changed_.SignalAll();
     ApplyGroup(stage.group);
     if (!stage.group.empty()) publication_held_ = false;
     applied_lsn_ = std::max(applied_lsn_, stage.group_lsn);
@@ -473,7 +474,7 @@ void MapStore::ApplyGroup(std::vector<Pending>& group) {
 
 void MapStore::IndexLabels(std::span<const StateLabel> labels) {
   if (labels.empty()) return;
-  std::lock_guard lock(groups_mutex_);
+  base::MutexLock lock(&groups_mutex_);
   for (const StateLabel& l : labels) {
     if (l.group.empty()) continue;
     std::vector<uint64_t>& members = groups_[l.group];
@@ -540,7 +541,7 @@ void MapStore::WaitCheckpointWrite() {
 
 absl::Status MapStore::WriteCheckpoint(uint64_t lsn, std::vector<Shard::CheckpointImage>& images) {
   // No backup copies the shards while they change, so that every copy is at one log position.
-  std::lock_guard backup(backup_mutex_);
+  base::MutexLock backup(&backup_mutex_);
   if (absl::Status error = WriteError(); !error.ok()) return error;  // latched meanwhile: see StartCheckpoint
   std::vector<absl::Status> writes(shards_.size());
   ParallelForShards(shards_.size(), [&](size_t s) { writes[s] = shards_[s]->WriteCheckpoint(images[s]); });
@@ -549,7 +550,7 @@ absl::Status MapStore::WriteCheckpoint(uint64_t lsn, std::vector<Shard::Checkpoi
     if (status.ok()) status = w;
   }
   if (status.ok()) {
-    std::lock_guard wal(wal_mutex_);
+    base::MutexLock wal(&wal_mutex_);
     status = wal_->DropThrough(lsn);
   }
   // Reader slots of processes that died while reading (a backup tool, mdb_stat) would pin old
@@ -602,7 +603,7 @@ absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStore::TopN(const std
                                                                       const PredictOptions& options) const {
   std::vector<uint64_t> members;
   {
-    std::lock_guard lock(groups_mutex_);
+    base::MutexLock lock(&groups_mutex_);
     auto it = groups_.find(group);
     if (it == groups_.end()) {
       return absl::NotFoundError(absl::StrCat("map ", info_.name, " has no group \"", group, "\""));
@@ -644,7 +645,7 @@ MapStats MapStore::Stats() const {
     stats.mean_prediction_error = stats.totals.prediction_error_sum / stats.totals.prediction_error_states;
   }
   {
-    std::lock_guard lock(last_update_mutex_);
+    base::MutexLock lock(&last_update_mutex_);
     stats.last_update = last_update_;
   }
   return stats;
@@ -654,7 +655,7 @@ absl::StatusOr<uint64_t> MapStore::Backup(const std::string& dir) {
   if (absl::Status s = MakeDir(dir); !s.ok()) return s;
   if (absl::Status s = Checkpoint(); !s.ok()) return s;
   // No checkpoint can run while this is held, so every shard's copy is at the same log position.
-  std::lock_guard backup(backup_mutex_);
+  base::MutexLock backup(&backup_mutex_);
   for (uint32_t i = 0; i < shards_.size(); ++i) {
     if (absl::Status s = shards_[i]->env().CopyTo(ShardDir(dir, i)); !s.ok()) return s;
   }
@@ -668,7 +669,7 @@ absl::StatusOr<uint64_t> MapStore::Backup(const std::string& dir) {
 }
 
 VerifyReport MapStore::Verify(absl::Time deadline) {
-  std::lock_guard backup(backup_mutex_);
+  base::MutexLock backup(&backup_mutex_);
   VerifyOptions options;
   options.isolate = true;
   options.live = true;

@@ -21,19 +21,19 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <deque>
 #include <functional>
 #include <future>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
+#include "base/mutex.h"
 #include "storage/batch.h"
 #include "storage/cell_key.h"
 #include "storage/dedup_table.h"
@@ -104,7 +104,8 @@ class MapStore {
   using AckCallback = std::function<void(absl::StatusOr<BatchAck>)>;
 
   static absl::StatusOr<std::unique_ptr<MapStore>> Open(const MapInfo& info, const std::string& dir,
-                                                        const StoreOptions& options);
+                                                        const StoreOptions& options)
+      ABSL_NO_THREAD_SAFETY_ANALYSIS;  // see Recover
   ~MapStore();
 
   const MapInfo& info() const { return info_; }
@@ -116,17 +117,17 @@ class MapStore {
   // or failed (an error status: the map refuses writes from now on). An error returned here means
   // `done` will not run: the batch is unusable (InvalidArgument, OutOfRange), the queue is full
   // (IsQueueFull), the map is closing (Unavailable) or refuses writes (WriteError()).
-  absl::Status Submit(ObservationBatch batch, AckCallback done);
+  absl::Status Submit(ObservationBatch batch, AckCallback done) ABSL_LOCKS_EXCLUDED(queue_mutex_);
   // Submit and wait. A batch refused as a whole comes back as its ack's error.
   absl::StatusOr<BatchAck> Write(ObservationBatch batch);
   // Runs `f` once when the queue can take a batch of `observations` — by the same rule Submit
   // applies — or the map stops taking writes (closing, or a latched error: then Submit tells why),
   // on a store thread, or at once when either holds now. A streaming handler whose Submit was
   // refused stops reading and resumes from here, instead of polling.
-  void OnRoom(uint64_t observations, std::function<void()> f);
+  void OnRoom(uint64_t observations, std::function<void()> f) ABSL_LOCKS_EXCLUDED(queue_mutex_);
   // The highest sequence of `writer` logged in this map (so applied, or to be applied before any
   // later batch), 0 when none: where a writer that lost its count continues.
-  uint64_t LastSequence(uint64_t writer) const;
+  uint64_t LastSequence(uint64_t writer) const ABSL_LOCKS_EXCLUDED(dedup_mutex_);
   // Checkpoints now and waits.
   absl::Status Checkpoint();
   // The update job's core (Shard::BeginPublication): republishes P, with its best order, of every
@@ -136,13 +137,13 @@ class MapStore {
   // published. `progress(done, total)` is called from time to time while the shards publish.
   absl::StatusOr<uint64_t> PublishModels(std::function<void(uint64_t, uint64_t)> progress = nullptr);
   // Keeps what an update job did, for Stats(), in <dir>/last_update (replaced atomically).
-  absl::Status RecordUpdate(const UpdateRecord& record);
+  absl::Status RecordUpdate(const UpdateRecord& record) ABSL_LOCKS_EXCLUDED(last_update_mutex_);
   // Stops accepting writes, finishes the queued ones and checkpoints. Idempotent.
-  absl::Status Close();
+  absl::Status Close() ABSL_LOCKS_EXCLUDED(queue_mutex_);
   // OK, or the error that stopped all writes to the map (a failed log sync, commit or checkpoint:
   // latched, so that nothing is acknowledged that might not be durable; no checkpoint or backup
   // is written after it either — the log holds every applied batch). Reads still work.
-  absl::Status WriteError() const;
+  absl::Status WriteError() const ABSL_LOCKS_EXCLUDED(queue_mutex_);
 
   // --- reads ---
   // p at every (time, key): out[i·keys + j] for times[i], keys[j].
@@ -156,18 +157,19 @@ class MapStore {
   std::optional<std::pair<std::string, std::string>> Label(uint64_t key) const { return ShardFor(key).Label(key); }
   // The n states of `group` most likely to be 1 at t, most likely first.
   absl::StatusOr<std::vector<std::pair<uint64_t, float>>> TopN(const std::string& group, double t, size_t n,
-                                                               const PredictOptions& options) const;
-  MapStats Stats() const;
+                                                               const PredictOptions& options) const
+      ABSL_LOCKS_EXCLUDED(groups_mutex_);
+  MapStats Stats() const ABSL_LOCKS_EXCLUDED(last_update_mutex_);
   // A consistent copy of every shard and the map's info into `dir` (created, must be empty).
   // Returns the bytes written.
-  absl::StatusOr<uint64_t> Backup(const std::string& dir);
+  absl::StatusOr<uint64_t> Backup(const std::string& dir) ABSL_LOCKS_EXCLUDED(backup_mutex_);
   // Verifies the map's files while it serves (storage/verify.h). Each shard is read in a forked
   // child process through LMDB's reader table: LMDB allows one environment per file per process,
   // and an abort on a damaged page ends the child, not the daemon. Checkpoints wait meanwhile (as
   // for a backup), so that the shards and the log are read at one position and no log segment is
   // dropped while it is read; batches go on being logged and acknowledged.
   // A shard not read by `deadline` is reported "not verified".
-  VerifyReport Verify(absl::Time deadline = absl::InfiniteFuture());
+  VerifyReport Verify(absl::Time deadline = absl::InfiniteFuture()) ABSL_LOCKS_EXCLUDED(backup_mutex_);
 
  private:
   // A submitted batch. Everything that needs no shared state — classification, the log record,
@@ -201,14 +203,17 @@ class MapStore {
   };
 
   MapStore(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings);
-  absl::Status Recover();
+  // Not analysed: Open and Recover fill the guarded members before the store is shared (its
+  // threads start last), when there is nothing to lock against.
+  absl::Status Recover() ABSL_NO_THREAD_SAFETY_ANALYSIS;
   // Reports a repair through StoreOptions::log_warning.
   void Warn(const std::string& message) const;
   void CommitLoop();
   // Appends the group's new batches to the log (marking retries as duplicates, refusing reused
-  // sequences); wal_mutex_ held.
-  void LogGroup(std::vector<Pending>& group);
-  void Latch(const absl::Status& status);
+  // sequences).
+  void LogGroup(std::vector<Pending>& group) ABSL_EXCLUSIVE_LOCKS_REQUIRED(wal_mutex_)
+      ABSL_LOCKS_EXCLUDED(dedup_mutex_);
+  void Latch(const absl::Status& status) ABSL_LOCKS_EXCLUDED(queue_mutex_);
   void ApplyLoop();
   void ApplyGroup(std::vector<Pending>& group);
   // Checkpoints at `lsn` in two steps (Shard::PrepareCheckpoint): the applier encodes every
@@ -216,7 +221,8 @@ class MapStore {
   // thread writes them into LMDB, drops the covered log and then answers `waiting`. One image at a
   // time: a new checkpoint first waits for the previous write.
   void StartCheckpoint(uint64_t lsn, std::vector<Control> waiting);
-  absl::Status WriteCheckpoint(uint64_t lsn, std::vector<Shard::CheckpointImage>& images);
+  absl::Status WriteCheckpoint(uint64_t lsn, std::vector<Shard::CheckpointImage>& images)
+      ABSL_LOCKS_EXCLUDED(backup_mutex_, wal_mutex_);
   bool CheckpointWriting() const;
   void WaitCheckpointWrite();
   // The applier's publication in progress (see PublishModels): Start marks the states (finishing
@@ -229,10 +235,10 @@ class MapStore {
   void SplitByShard(Pending& pending) const;
   // Classifies, encodes and splits a batch.
   Pending Prepare(ObservationBatch batch, AckCallback done) const;
-  void IndexLabels(std::span<const StateLabel> labels);
+  void IndexLabels(std::span<const StateLabel> labels) ABSL_LOCKS_EXCLUDED(groups_mutex_);
   // Whether the queue takes n more observations. One batch is always let in, however big, so that
-  // a single huge scan is not refused forever. REQUIRES: queue_mutex_ held.
-  bool FitsLocked(uint64_t n) const {
+  // a single huge scan is not refused forever.
+  bool FitsLocked(uint64_t n) const ABSL_SHARED_LOCKS_REQUIRED(queue_mutex_) {
     return queued_observations_ == 0 || queued_observations_ + n <= options_.max_queued_observations;
   }
   const Shard& ShardFor(uint64_t key) const { return *shards_[ShardOf(key, info_.shards)]; }
@@ -243,10 +249,12 @@ class MapStore {
   std::unique_ptr<model::ModelSettings> settings_;
   std::vector<std::unique_ptr<Shard>> shards_;
   std::unique_ptr<ShardWorkers> workers_;
+  // Not ABSL_PT_GUARDED_BY(wal_mutex_): its counters (bytes, durable_lsn) are atomics that the
+  // applier and Stats read without it.
   std::unique_ptr<WalWriter> wal_;
-  std::mutex wal_mutex_;      // the committer's appends and syncs, the applier's drops
-  mutable std::mutex dedup_mutex_;  // held by the committer to change dedup_, by LastSequence to read it
-  DedupTable dedup_;                // the committer's: what was logged
+  base::Mutex wal_mutex_;      // the committer's appends and syncs, the applier's drops
+  mutable base::Mutex dedup_mutex_;  // held by the committer to change dedup_, by LastSequence to read it
+  DedupTable dedup_ ABSL_GUARDED_BY(dedup_mutex_);  // the committer's: what was logged
   DedupTable applied_dedup_;  // applier only: what was applied, recorded by checkpoints
   uint64_t applied_lsn_ = 0;  // applier only
   std::optional<Control> publication_;     // applier only: the publication in progress
@@ -255,26 +263,28 @@ class MapStore {
   std::vector<Control> waiting_checkpoints_;  // applier only: checkpoints asked during a publication
   std::future<void> checkpoint_write_;        // applier only: the image being written, if any
 
-  mutable std::mutex queue_mutex_;
-  std::condition_variable queue_ready_;
-  std::deque<Pending> queue_;
-  uint64_t queued_observations_ = 0;
-  bool closing_ = false;
-  std::vector<Control> controls_;
-  std::vector<std::function<void()>> room_waiters_;
-  absl::Status write_error_;  // latched: a failed log sync or checkpoint stops all writes
+  mutable base::Mutex queue_mutex_;
+  base::CondVar queue_ready_;
+  std::deque<Pending> queue_ ABSL_GUARDED_BY(queue_mutex_);
+  uint64_t queued_observations_ ABSL_GUARDED_BY(queue_mutex_) = 0;
+  bool closing_ ABSL_GUARDED_BY(queue_mutex_) = false;
+  std::vector<Control> controls_ ABSL_GUARDED_BY(queue_mutex_);
+  std::vector<std::function<void()>> room_waiters_ ABSL_GUARDED_BY(queue_mutex_);
+  // Latched: a failed log sync or checkpoint stops all writes.
+  absl::Status write_error_ ABSL_GUARDED_BY(queue_mutex_);
 
-  std::mutex backup_mutex_;  // held by checkpoints and backups: a backup sees one checkpoint
+  // Guards no member: held by checkpoints and backups, so that a backup sees one checkpoint.
+  base::Mutex backup_mutex_;
 
-  mutable std::mutex last_update_mutex_;
-  std::optional<UpdateRecord> last_update_;
+  mutable base::Mutex last_update_mutex_;
+  std::optional<UpdateRecord> last_update_ ABSL_GUARDED_BY(last_update_mutex_);
 
-  mutable std::mutex groups_mutex_;
-  absl::flat_hash_map<std::string, std::vector<uint64_t>> groups_;
+  mutable base::Mutex groups_mutex_;
+  absl::flat_hash_map<std::string, std::vector<uint64_t>> groups_ ABSL_GUARDED_BY(groups_mutex_);
 
-  std::mutex stage_mutex_;
-  std::condition_variable stage_changed_;
-  std::deque<Stage> stages_;
+  base::Mutex stage_mutex_;
+  base::CondVar stage_changed_;
+  std::deque<Stage> stages_ ABSL_GUARDED_BY(stage_mutex_);
 
   std::thread committer_;
   std::thread applier_;

@@ -6,7 +6,6 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
-#include <mutex>
 #include <optional>
 
 #include "absl/container/flat_hash_set.h"
@@ -563,7 +562,7 @@ namespace fremen::storage {
 absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const std::string& new_name,
                                                 absl::Time deadline) {
   const std::string target_name = new_name.empty() ? name + "-salvaged" : new_name;
-  std::unique_lock lock(mutex_);
+  base::MutexLock lock(&mutex_);
   const auto failed = failed_.find(name);
   if (failed == failed_.end()) {
     if (maps_.contains(name)) {
@@ -594,7 +593,7 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
   const std::string from_dir = failed->second.dir;
   salvaging_.insert(name);
   salvaging_.insert(target_name);
-  lock.unlock();
+  mutex_.Unlock();
   // The id has no directory (Create skipped those that do): everything under `target` is this call's, and only that is
   // removed when the salvage fails.
   const std::string target = MapDir(created->id);
@@ -606,7 +605,7 @@ absl::StatusOr<SalvageReport> Store::SalvageMap(const std::string& name, const s
   } else {
     report = SalvageFiles(from_dir, target, *created, options_, deadline);
   }
-  lock.lock();
+  mutex_.Lock();
   salvaging_.erase(name);
   salvaging_.erase(target_name);
   if (report.ok()) {

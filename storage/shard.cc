@@ -165,7 +165,7 @@ model::CompactStateModel Shard::ModelOf(uint32_t d) const {
 }
 
 void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::span<const float> values) {
-  std::unique_lock lock(mutex_);
+  base::WriterMutexLock lock(&mutex_);
   const double t = scan.table.time();
   scan_cells_.clear();
   scan_values_.clear();
@@ -234,7 +234,7 @@ void Shard::ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring
 }
 
 void Shard::ApplyLabels(std::span<const StateLabel> labels) {
-  std::unique_lock lock(mutex_);
+  base::WriterMutexLock lock(&mutex_);
   for (const StateLabel& label : labels) {
     labels_[label.key] = {label.name, label.group};
     dirty_labels_.push_back(label.key);
@@ -269,7 +269,7 @@ void Shard::PredictPublished(std::span<const uint32_t> dynamic, const model::Pha
 }
 
 float Shard::Predict(uint64_t key, const model::PhasorTable& table, const PredictOptions& options) const {
-  std::shared_lock lock(mutex_);
+  base::ReaderMutexLock lock(&mutex_);
   const auto it = bricks_.find(BrickOf(key));
   if (it == bricks_.end()) return kUnobservedProbability;
   return PredictHandle(brick_data_[it->second].handles[key & 511], table, options);
@@ -278,7 +278,7 @@ float Shard::Predict(uint64_t key, const model::PhasorTable& table, const Predic
 void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
                        float* out) const {
   if (box.cell_count() == 0) return;
-  std::shared_lock lock(mutex_);
+  base::ReaderMutexLock lock(&mutex_);
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
   const std::array<uint32_t, 3> bs = grid_keys_.brick_size();
   // A cell's index in its brick is its key's low 9 bits: the sum of each axis' bits, spread —
@@ -330,20 +330,20 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
 }
 
 bool Shard::Observed(uint64_t key) const {
-  std::shared_lock lock(mutex_);
+  base::ReaderMutexLock lock(&mutex_);
   const auto it = bricks_.find(BrickOf(key));
   return it != bricks_.end() && brick_data_[it->second].handles[key & 511] != kNone;
 }
 
 std::optional<std::pair<std::string, std::string>> Shard::Label(uint64_t key) const {
-  std::shared_lock lock(mutex_);
+  base::ReaderMutexLock lock(&mutex_);
   const auto it = labels_.find(key);
   if (it == labels_.end()) return std::nullopt;
   return it->second;
 }
 
 std::optional<StateSnapshot> Shard::Snapshot(uint64_t key) const {
-  std::shared_lock lock(mutex_);
+  base::ReaderMutexLock lock(&mutex_);
   const uint32_t slot = FindSlot(key);
   if (slot == kNone) return std::nullopt;
   StateSnapshot snapshot;
@@ -362,7 +362,7 @@ std::optional<StateSnapshot> Shard::Snapshot(uint64_t key) const {
 }
 
 ShardStats Shard::Stats() const {
-  std::shared_lock lock(mutex_);
+  base::ReaderMutexLock lock(&mutex_);
   ShardStats stats;
   for (const Slot& slot : slots_) stats.states += slot.observed;
   stats.dynamic_states = slot_of_.size();
@@ -399,7 +399,7 @@ ShardStats Shard::Stats() const {
 }
 
 void Shard::ForEachKey(const std::function<void(uint64_t)>& f) const {
-  std::shared_lock lock(mutex_);
+  base::ReaderMutexLock lock(&mutex_);
   for (const Slot& slot : slots_) {
     if (slot.observed) f(slot.key);
   }
@@ -407,7 +407,7 @@ void Shard::ForEachKey(const std::function<void(uint64_t)>& f) const {
 
 void Shard::ForEachLabel(
     const std::function<void(uint64_t, const std::string&, const std::string&)>& f) const {
-  std::shared_lock lock(mutex_);
+  base::ReaderMutexLock lock(&mutex_);
   for (const auto& [key, label] : labels_) f(key, label.first, label.second);
 }
 
@@ -415,9 +415,10 @@ Shard::CheckpointImage Shard::PrepareCheckpoint(uint64_t lsn, const DedupTable& 
   CheckpointImage image;
   image.lsn = lsn;
   {
-    std::shared_lock lock(mutex_);  // the writer is the caller: only readers run alongside
+    base::ReaderMutexLock lock(&mutex_);  // the writer is the caller: only readers run alongside
     std::vector<uint32_t> dirty = dirty_slots_;
-    std::sort(dirty.begin(), dirty.end(), [&](uint32_t a, uint32_t b) { return slots_[a].key < slots_[b].key; });
+    std::sort(dirty.begin(), dirty.end(),
+              [&](uint32_t a, uint32_t b) ABSL_SHARED_LOCKS_REQUIRED(mutex_) { return slots_[a].key < slots_[b].key; });
     std::vector<uint64_t> dirty_bricks;
     for (uint32_t slot : dirty) {
       const uint64_t brick = BrickOf(slots_[slot].key);
@@ -449,7 +450,7 @@ Shard::CheckpointImage Shard::PrepareCheckpoint(uint64_t lsn, const DedupTable& 
     image.touched = EncodeTouched();
     image.dedup = dedup.Encode();
   }
-  std::unique_lock exclusive(mutex_);
+  base::WriterMutexLock exclusive(&mutex_);
   for (uint32_t slot : dirty_slots_) slots_[slot].dirty = 0;
   dirty_slots_.clear();
   dirty_labels_.clear();
@@ -459,7 +460,7 @@ Shard::CheckpointImage Shard::PrepareCheckpoint(uint64_t lsn, const DedupTable& 
 }
 
 absl::Status Shard::WriteCheckpoint(const CheckpointImage& image) {
-  std::lock_guard lock(checkpoint_write_mutex_);
+  base::MutexLock lock(&checkpoint_write_mutex_);
   // The states of a failed image are clean in memory but not on disk: a later image must not
   // move the checkpoint past them.
   if (!checkpoint_write_error_.ok()) return checkpoint_write_error_;
@@ -499,7 +500,7 @@ absl::Status Shard::WriteCheckpoint(const CheckpointImage& image) {
 }
 
 absl::Status Shard::Load() {
-  return env_->Read([&](LmdbTxn& txn) -> absl::Status {
+  return env_->Read([&](LmdbTxn& txn) ABSL_NO_THREAD_SAFETY_ANALYSIS -> absl::Status {
     auto meta_db = txn.Db(kMetaDb);
     if (absl::IsNotFound(meta_db.status())) return absl::OkStatus();  // a new shard
     if (!meta_db.ok()) return meta_db.status();
@@ -544,10 +545,12 @@ absl::Status Shard::Load() {
       });
       return scanned.ok() ? failure : scanned;
     };
-    if (absl::Status s = scan(kStaticDb, [&](uint64_t brick, std::string_view value) -> absl::Status {
+    // The lambdas below are not analysed either (see Load).
+    if (absl::Status s = scan(kStaticDb, [&](uint64_t brick, std::string_view value) ABSL_NO_THREAD_SAFETY_ANALYSIS
+                                  -> absl::Status {
           auto decoded = StaticBrick::Decode(value);
           if (!decoded.ok()) return decoded.status();
-          decoded->ForEach([&](uint32_t i, const model::StaticState& state) {
+          decoded->ForEach([&](uint32_t i, const model::StaticState& state) ABSL_NO_THREAD_SAFETY_ANALYSIS {
             const uint64_t key = brick << kBrickBits | i;
             slots_[FindOrAddSlot(key)].static_state = state;
             SetHandle(key, kStaticHandle | static_cast<uint32_t>(state.value()));
@@ -557,7 +560,8 @@ absl::Status Shard::Load() {
         !s.ok()) {
       return s;
     }
-    if (absl::Status s = scan(kDynamicDb, [&](uint64_t key, std::string_view value) -> absl::Status {
+    if (absl::Status s = scan(kDynamicDb, [&](uint64_t key, std::string_view value) ABSL_NO_THREAD_SAFETY_ANALYSIS
+                                  -> absl::Status {
           auto decoded = model::DecodeStateModel<float>(value, settings_);
           if (!decoded.ok()) return decoded.status();
           const uint32_t slot = FindOrAddSlot(key);
@@ -567,7 +571,8 @@ absl::Status Shard::Load() {
         !s.ok()) {
       return s;
     }
-    if (absl::Status s = scan(kLosslessDb, [&](uint64_t key, std::string_view value) -> absl::Status {
+    if (absl::Status s = scan(kLosslessDb, [&](uint64_t key, std::string_view value) ABSL_NO_THREAD_SAFETY_ANALYSIS
+                                  -> absl::Status {
           auto decoded = model::LosslessHistory::Decode(value);
           if (!decoded.ok()) return decoded.status();
           const uint32_t slot = FindSlot(key);
@@ -581,7 +586,8 @@ absl::Status Shard::Load() {
       return s;
     }
     // After the float records: a wide state's exact double body replaces the one widened from them.
-    if (absl::Status s = scan(kWideDb, [&](uint64_t key, std::string_view value) -> absl::Status {
+    if (absl::Status s = scan(kWideDb, [&](uint64_t key, std::string_view value) ABSL_NO_THREAD_SAFETY_ANALYSIS
+                                  -> absl::Status {
           const uint32_t slot = FindSlot(key);
           if (slot == kNone || slots_[slot].dynamic == kNone) return absl::DataLossError("a wide body without its state");
           return wide_.Decode(slots_[slot].dynamic, value);
@@ -592,7 +598,7 @@ absl::Status Shard::Load() {
     if (touched) {
       if (absl::Status s = DecodeTouched(*touched); !s.ok()) return s;
     }
-    return scan(kLabelsDb, [&](uint64_t key, std::string_view value) -> absl::Status {
+    return scan(kLabelsDb, [&](uint64_t key, std::string_view value) ABSL_NO_THREAD_SAFETY_ANALYSIS -> absl::Status {
       auto label = shard_records::DecodeLabel(value);
       if (!label.ok()) return label.status();
       labels_[key] = *std::move(label);

@@ -21,7 +21,9 @@
 // Thread-safety: Apply*, PrepareCheckpoint and Publish* are called by one writer (the map's committer,
 // through the shard's owner; WriteCheckpoint may run on another thread); readers may call the
 // const query methods concurrently with them —
-// an internal shared mutex keeps a reader from seeing a half-applied batch.
+// an internal shared mutex keeps a reader from seeing a half-applied batch. The tables readers see
+// are ABSL_GUARDED_BY it: readers hold it shared, the writer changes them holding it exclusively and
+// may read them without it (nothing else changes them; WritersHistory is such a read).
 #pragma once
 
 #include <array>
@@ -29,16 +31,16 @@
 #include <functional>
 #include <cstdint>
 #include <memory>
-#include <mutex>
 #include <optional>
-#include <shared_mutex>
 #include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
+#include "base/mutex.h"
 #include "storage/batch.h"
 #include "storage/dedup_table.h"
 #include "storage/lmdb/lmdb_env.h"
@@ -178,48 +180,57 @@ class Shard {
     std::array<uint32_t, 512 / kChunk> chunk_base;     // first slot of each run of 64 keys, or kNone
   };
 
-  uint32_t FindSlot(uint64_t key) const;
+  uint32_t FindSlot(uint64_t key) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // The slot of local index i of a brick, or kNone when that cell was never observed.
-  uint32_t SlotAt(const Brick& brick, uint32_t local) const;
+  uint32_t SlotAt(const Brick& brick, uint32_t local) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // The brick of a key, created when missing. Consecutive calls for one brick cost no hash lookup.
-  Brick& BrickFor(uint64_t key);
-  uint32_t FindOrAddSlot(uint64_t key);
+  Brick& BrickFor(uint64_t key) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  uint32_t FindOrAddSlot(uint64_t key) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // The slot a key has or will have (allocating its run of 64), without touching the slot itself.
-  uint32_t ReserveSlot(uint64_t key);
-  void SetHandle(uint64_t key, uint32_t handle) { BrickFor(key).handles[key & 511] = handle; }
-  uint32_t Promote(uint32_t slot);  // static → dynamic; returns the dynamic index
+  uint32_t ReserveSlot(uint64_t key) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  void SetHandle(uint64_t key, uint32_t handle) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_) {
+    BrickFor(key).handles[key & 511] = handle;
+  }
+  // Static → dynamic; returns the dynamic index.
+  uint32_t Promote(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // Apply's second part: scores and folds the scan's observations of wide states (scan_wide_*).
-  void ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring);
+  void ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // What every observation of a dynamic state updates besides its spectrum and order errors.
-  void ObserveBesidesSpectrum(uint32_t d, double t, float value);
-  uint32_t AddDynamic(uint32_t slot);
-  void MarkDirty(uint32_t slot);
+  void ObserveBesidesSpectrum(uint32_t d, double t, float value) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  uint32_t AddDynamic(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  void MarkDirty(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // p(t) of the state behind a handle (see kStaticHandle).
-  float PredictHandle(uint32_t handle, const model::PhasorTable& table, const PredictOptions& options) const;
+  float PredictHandle(uint32_t handle, const model::PhasorTable& table, const PredictOptions& options) const
+      ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // out[i] = p(t) of dynamic state dynamic[i], each with a published model: the region kernel
   // (model/region_predict.h, what the benchmark measures), then persistence when asked for.
   void PredictPublished(std::span<const uint32_t> dynamic, const model::PhasorTable& table,
-                        const PredictOptions& options, float* out) const;
+                        const PredictOptions& options, float* out) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // Publishes one dynamic state (see BeginPublication) and clears its flags; `history_updated`:
-  // the caller has updated its lossless history already (outside the lock). REQUIRES: mutex_ held
-  // exclusively.
-  void PublishState(uint32_t dynamic, bool history_updated = false);
+  // the caller has updated its lossless history already (outside the lock).
+  void PublishState(uint32_t dynamic, bool history_updated = false) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // The touched states' keys for the checkpoint (delta varints, in key order), and back.
-  std::string EncodeTouched() const;
-  absl::Status DecodeTouched(std::string_view bytes);
-  model::CompactStateModel ModelOf(uint32_t dynamic) const;
-  void StoreModel(uint32_t dynamic, const model::CompactStateModel& model);
-  absl::Status Load();
+  std::string EncodeTouched() const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  absl::Status DecodeTouched(std::string_view bytes) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  model::CompactStateModel ModelOf(uint32_t dynamic) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  void StoreModel(uint32_t dynamic, const model::CompactStateModel& model) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // Not analysed: Open calls it before the shard is shared, when there is nothing to lock against.
+  absl::Status Load() ABSL_NO_THREAD_SAFETY_ANALYSIS;
+  // A copy of a lossless history, for the writer only, without the lock: no other thread changes
+  // the tables, so the writer reads them as they are (not analysed: the analysis knows no such role).
+  model::LosslessHistory WritersHistory(uint32_t dynamic) const ABSL_NO_THREAD_SAFETY_ANALYSIS {
+    return lossless_histories_[dynamic];
+  }
 
   const MapInfo map_;
   const model::ModelSettings& settings_;
   const bool lossless_;
   const GridKeys grid_keys_;
   std::unique_ptr<LmdbEnv> env_;
-  mutable std::shared_mutex mutex_;
+  mutable base::SharedMutex mutex_;
 
-  absl::flat_hash_map<uint64_t, uint32_t> bricks_;  // brick → index into bricks_data_
-  std::vector<Brick> brick_data_;
+  absl::flat_hash_map<uint64_t, uint32_t> bricks_ ABSL_GUARDED_BY(mutex_);  // brick → index into bricks_data_
+  std::vector<Brick> brick_data_ ABSL_GUARDED_BY(mutex_);
   uint64_t cached_brick_ = UINT64_MAX;  // BrickFor's last brick and its index
   uint32_t cached_brick_index_ = 0;
   // Per slot.
@@ -232,18 +243,18 @@ class Shard {
     uint8_t observed = 0;      // a slot of an allocated run whose cell has not been seen is unused
   };
   static_assert(sizeof(Slot) == 32);
-  std::vector<Slot> slots_;
+  std::vector<Slot> slots_ ABSL_GUARDED_BY(mutex_);
   std::vector<uint32_t> dirty_slots_;
   // Per dynamic state.
-  std::vector<uint32_t> slot_of_;
-  model::RecordArena spectra_;
+  std::vector<uint32_t> slot_of_ ABSL_GUARDED_BY(mutex_);
+  model::RecordArena spectra_ ABSL_GUARDED_BY(mutex_);
   // Double bodies of the spectra with more observations than float keeps accurately.
-  model::WideBodies wide_;
+  model::WideBodies wide_ ABSL_GUARDED_BY(mutex_);
   const uint32_t widen_at_;
-  model::CompactModels models_;
-  model::OrderErrorTable errors_;
-  std::vector<model::Persistence> persistence_;
-  std::vector<model::LosslessHistory> lossless_histories_;
+  model::CompactModels models_ ABSL_GUARDED_BY(mutex_);
+  model::OrderErrorTable errors_ ABSL_GUARDED_BY(mutex_);
+  std::vector<model::Persistence> persistence_ ABSL_GUARDED_BY(mutex_);
+  std::vector<model::LosslessHistory> lossless_histories_ ABSL_GUARDED_BY(mutex_);
   // Per dynamic state: kTouched (observed since its last publication; checkpointed as the meta
   // record "touched") and kPending (awaiting the publication in progress). Writer only.
   static constexpr uint8_t kTouched = 1, kPending = 2;
@@ -254,7 +265,7 @@ class Shard {
   model::Publisher publisher_;
   model::CompactSpectrum publish_scratch_;
   // Generic maps' labels.
-  absl::flat_hash_map<uint64_t, std::pair<std::string, std::string>> labels_;
+  absl::flat_hash_map<uint64_t, std::pair<std::string, std::string>> labels_ ABSL_GUARDED_BY(mutex_);
   std::vector<uint64_t> dirty_labels_;
   // Scratch of Apply.
   std::vector<uint32_t> scan_slots_;
@@ -264,8 +275,8 @@ class Shard {
   std::vector<float> scan_wide_values_;
 
   uint64_t checkpoint_lsn_ = 0;  // of the last image prepared
-  std::mutex checkpoint_write_mutex_;
-  absl::Status checkpoint_write_error_;  // guarded by checkpoint_write_mutex_
+  base::Mutex checkpoint_write_mutex_;
+  absl::Status checkpoint_write_error_ ABSL_GUARDED_BY(checkpoint_write_mutex_);
   DedupTable checkpoint_dedup_;
 };
 

@@ -53,15 +53,15 @@ bool Shard::ContinuePublication(std::chrono::nanoseconds budget) {
       // writer, so the history cannot change meanwhile): readers wait only for the swap.
       const uint32_t d = publication_list_[publication_cursor_++];
       if (publish_flags_[d] & kPending) {
-        model::LosslessHistory updated = lossless_histories_[d];
+        model::LosslessHistory updated = WritersHistory(d);
         (void)updated.Update(settings_.max_order);
-        std::unique_lock lock(mutex_);
+        base::WriterMutexLock lock(&mutex_);
         std::swap(lossless_histories_[d], updated);
         PublishState(d, /*history_updated=*/true);
       }
     } else {
       const size_t end = std::min(publication_list_.size(), publication_cursor_ + kStatesPerLock);
-      std::unique_lock lock(mutex_);
+      base::WriterMutexLock lock(&mutex_);
       for (; publication_cursor_ < end; ++publication_cursor_) {
         const uint32_t d = publication_list_[publication_cursor_];
         if (publish_flags_[d] & kPending) PublishState(d);  // else a batch published it first

@@ -14,20 +14,20 @@ ShardWorkers::ShardWorkers(uint32_t shards, const std::string& name) {
 
 ShardWorkers::~ShardWorkers() {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     stopping_ = true;
   }
-  work_ready_.notify_all();
+  work_ready_.SignalAll();
   for (std::thread& t : threads_) t.join();
 }
 
 void ShardWorkers::RunOnAll(const std::function<void(uint32_t)>& f) {
-  std::unique_lock lock(mutex_);
+  base::MutexLock lock(&mutex_);
   task_ = &f;
   pending_ = static_cast<uint32_t>(threads_.size());
   ++generation_;
-  work_ready_.notify_all();
-  work_done_.wait(lock, [&] { return pending_ == 0; });
+  work_ready_.SignalAll();
+  while (pending_ != 0) work_done_.Wait(&mutex_);
   task_ = nullptr;
 }
 
@@ -36,16 +36,16 @@ void ShardWorkers::Loop(uint32_t shard) {
   for (;;) {
     const std::function<void(uint32_t)>* task;
     {
-      std::unique_lock lock(mutex_);
-      work_ready_.wait(lock, [&] { return stopping_ || generation_ != seen; });
+      base::MutexLock lock(&mutex_);
+      while (!stopping_ && generation_ == seen) work_ready_.Wait(&mutex_);
       if (stopping_) return;
       seen = generation_;
       task = task_;
     }
     (*task)(shard);
     {
-      std::lock_guard lock(mutex_);
-      if (--pending_ == 0) work_done_.notify_one();
+      base::MutexLock lock(&mutex_);
+      if (--pending_ == 0) work_done_.Signal();
     }
   }
 }

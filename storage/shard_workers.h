@@ -4,13 +4,14 @@
 // Thread-safety: RunOnAll is called by one thread at a time (the committer).
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "base/mutex.h"
 
 namespace fremen::storage {
 
@@ -22,17 +23,17 @@ class ShardWorkers {
   ShardWorkers(const ShardWorkers&) = delete;
   ShardWorkers& operator=(const ShardWorkers&) = delete;
 
-  void RunOnAll(const std::function<void(uint32_t)>& f);
+  void RunOnAll(const std::function<void(uint32_t)>& f) ABSL_LOCKS_EXCLUDED(mutex_);
 
  private:
-  void Loop(uint32_t shard);
+  void Loop(uint32_t shard) ABSL_LOCKS_EXCLUDED(mutex_);
 
-  std::mutex mutex_;
-  std::condition_variable work_ready_, work_done_;
-  const std::function<void(uint32_t)>* task_ = nullptr;
-  uint64_t generation_ = 0;
-  uint32_t pending_ = 0;
-  bool stopping_ = false;
+  base::Mutex mutex_;
+  base::CondVar work_ready_, work_done_;
+  const std::function<void(uint32_t)>* task_ ABSL_GUARDED_BY(mutex_) = nullptr;
+  uint64_t generation_ ABSL_GUARDED_BY(mutex_) = 0;
+  uint32_t pending_ ABSL_GUARDED_BY(mutex_) = 0;
+  bool stopping_ ABSL_GUARDED_BY(mutex_) = false;
   std::vector<std::thread> threads_;
 };
 

@@ -56,7 +56,7 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& data_dir, 
   if (*format == 0) {
     if (absl::Status written = WriteDataDirFormat(options.env, data_dir); !written.ok()) return written;
   }
-  std::lock_guard lock(store->mutex_);
+  base::MutexLock lock(&store->mutex_);
   for (const MapInfo& info : all) {
     if (auto map = store->OpenMap(info); !map.ok()) {
       store->failed_[info.name] =
@@ -93,7 +93,7 @@ void Store::FindUnknownDirectories(const std::vector<MapInfo>& maps) {
 }
 
 std::vector<FailedMap> Store::FailedMaps() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   std::vector<FailedMap> failed;
   for (const auto& [name, map] : failed_) failed.push_back(map);
   std::sort(failed.begin(), failed.end(), [](const FailedMap& a, const FailedMap& b) { return a.name < b.name; });
@@ -130,7 +130,7 @@ absl::StatusOr<std::shared_ptr<MapStore>> Store::OpenMap(const MapInfo& info) {
 }
 
 absl::StatusOr<MapInfo> Store::CreateMap(MapInfo info) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   auto created =
       catalog_->Create(std::move(info), options_.default_shards, [this](uint64_t id) { return HasDirectory(id); });
   if (!created.ok()) return created.status();
@@ -151,7 +151,7 @@ absl::StatusOr<MapPage> Store::ListMaps(size_t page_size, const std::string& pag
 }
 
 absl::StatusOr<std::shared_ptr<MapStore>> Store::Map(const std::string& name) const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (auto it = maps_.find(name); it != maps_.end()) return it->second;
   if (auto it = failed_.find(name); it != failed_.end()) return it->second.status;
   if (salvaging_.contains(name)) {
@@ -161,7 +161,7 @@ absl::StatusOr<std::shared_ptr<MapStore>> Store::Map(const std::string& name) co
 }
 
 absl::Status Store::DeleteMap(const std::string& name) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (salvaging_.contains(name)) {
     return absl::FailedPreconditionError(absl::StrCat("map ", name, " is being salvaged; delete it once that ends"));
   }
@@ -214,7 +214,7 @@ absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::str
                                                 : ""));
   }
   if (!name.empty()) info.name = name;
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   auto created = catalog_->Create(info, info.shards, [this](uint64_t id) { return HasDirectory(id); });
   if (!created.ok()) return created.status();
   // The id has no directory (Create skipped those that do): everything under `target` is this call's, and only that is
@@ -243,7 +243,7 @@ absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::str
 }
 
 absl::Status Store::Close() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   absl::Status first;
   for (auto& [name, map] : maps_) {
     absl::Status s = map->Close();

@@ -18,13 +18,14 @@
 #pragma once
 
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
 #include "absl/container/flat_hash_set.h"
 #include "absl/status/statusor.h"
+#include "base/mutex.h"
 #include "storage/catalog.h"
 #include "storage/map_store.h"
 #include "storage/salvage.h"
@@ -46,22 +47,22 @@ class Store {
   static absl::StatusOr<std::unique_ptr<Store>> Open(const std::string& data_dir, const StoreOptions& options);
   ~Store();
 
-  absl::StatusOr<MapInfo> CreateMap(MapInfo info);
+  absl::StatusOr<MapInfo> CreateMap(MapInfo info) ABSL_LOCKS_EXCLUDED(mutex_);
   absl::StatusOr<MapInfo> GetMap(const std::string& name) const;
   absl::StatusOr<MapPage> ListMaps(size_t page_size, const std::string& page_token) const;
   // Removes the map and all its files (a failed map too).
-  absl::Status DeleteMap(const std::string& name);
+  absl::Status DeleteMap(const std::string& name) ABSL_LOCKS_EXCLUDED(mutex_);
   // The open map; NotFound when there is none by that name, the map's error when it is failed.
-  absl::StatusOr<std::shared_ptr<MapStore>> Map(const std::string& name) const;
+  absl::StatusOr<std::shared_ptr<MapStore>> Map(const std::string& name) const ABSL_LOCKS_EXCLUDED(mutex_);
 
   // A consistent copy of a map to `dir`, while it keeps serving.
   // Returns the bytes written.
-  absl::StatusOr<uint64_t> BackupMap(const std::string& name, const std::string& dir);
+  absl::StatusOr<uint64_t> BackupMap(const std::string& name, const std::string& dir) ABSL_LOCKS_EXCLUDED(mutex_);
   // A backup made by BackupMap as a new map named `name` (empty: the backed-up map's name). The copy is probed and
   // loaded (every record checked) before the map is listed.
   // A shard whose check has not finished by `deadline` makes it DeadlineExceeded, nothing created.
   absl::StatusOr<MapInfo> RestoreMap(const std::string& dir, const std::string& name,
-                                     absl::Time deadline = absl::InfiniteFuture());
+                                     absl::Time deadline = absl::InfiniteFuture()) ABSL_LOCKS_EXCLUDED(mutex_);
 
   // A new map `new_name` (empty: name + "-salvaged") holding everything of the failed map `name` that verifies, served
   // once it opens like any other (storage/salvage.h); the failed map and its files are left as they are. NotFound for
@@ -71,15 +72,15 @@ class Store {
   // returns, both maps refuse DeleteMap and Map(new_name) answers Unavailable.
   // Not finished by `deadline`: DeadlineExceeded, and the new map's directory is removed.
   absl::StatusOr<SalvageReport> SalvageMap(const std::string& name, const std::string& new_name,
-                                           absl::Time deadline = absl::InfiniteFuture());
+                                           absl::Time deadline = absl::InfiniteFuture()) ABSL_LOCKS_EXCLUDED(mutex_);
 
   // Maps that did not open at Open, in name order.
-  std::vector<FailedMap> FailedMaps() const;
+  std::vector<FailedMap> FailedMaps() const ABSL_LOCKS_EXCLUDED(mutex_);
   // Directories under <data dir>/maps that no catalog record names (full paths, sorted).
   std::vector<std::string> UnknownDirectories() const;
 
   // Stops every map (finishing queued writes and checkpointing).
-  absl::Status Close();
+  absl::Status Close() ABSL_LOCKS_EXCLUDED(mutex_);
 
  private:
   Store(std::string data_dir, StoreOptions options, std::unique_ptr<Catalog> catalog)
@@ -88,7 +89,7 @@ class Store {
   // Whether maps/<id> exists: such an id is never given to a new map.
   bool HasDirectory(uint64_t id) const;
   // Probes (when enabled) and opens the map's files; on success the map is served.
-  absl::StatusOr<std::shared_ptr<MapStore>> OpenMap(const MapInfo& info);
+  absl::StatusOr<std::shared_ptr<MapStore>> OpenMap(const MapInfo& info) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // Every catalog record, good ones in `maps` and damaged ones in `damaged`.
   absl::Status ListCatalog(std::vector<MapInfo>& maps, std::vector<DamagedCatalogEntry>& damaged) const;
   void FindUnknownDirectories(const std::vector<MapInfo>& maps);
@@ -96,11 +97,11 @@ class Store {
   const std::string data_dir_;
   const StoreOptions options_;
   std::unique_ptr<Catalog> catalog_;
-  mutable std::mutex mutex_;  // guards maps_, failed_, salvaging_ and serialises create/delete/restore
-  absl::flat_hash_map<std::string, std::shared_ptr<MapStore>> maps_;
-  absl::flat_hash_map<std::string, FailedMap> failed_;
+  mutable base::Mutex mutex_;  // guards maps_, failed_, salvaging_ and serialises create/delete/restore
+  absl::flat_hash_map<std::string, std::shared_ptr<MapStore>> maps_ ABSL_GUARDED_BY(mutex_);
+  absl::flat_hash_map<std::string, FailedMap> failed_ ABSL_GUARDED_BY(mutex_);
   // Maps a salvage reads or creates, without holding mutex_ (SalvageMap): not deleted meanwhile.
-  absl::flat_hash_set<std::string> salvaging_;
+  absl::flat_hash_set<std::string> salvaging_ ABSL_GUARDED_BY(mutex_);
   std::vector<std::string> unknown_dirs_;  // found at Open; read-only after
 };
 

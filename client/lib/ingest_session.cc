@@ -1,6 +1,5 @@
 #include "client/lib/ingest_session.h"
 
-#include <chrono>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -14,7 +13,7 @@ namespace {
 
 // How long the reader waits for a writer to notice a broken stream before cancelling the call to
 // unblock it (a write blocked in flow control on a dead link).
-constexpr auto kWriterGrace = std::chrono::seconds(1);
+constexpr absl::Duration kWriterGrace = absl::Seconds(1);
 
 }  // namespace
 
@@ -63,10 +62,10 @@ IngestSession::IngestSession(std::shared_ptr<Connection> connection, std::string
 
 IngestSession::~IngestSession() {
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     stopping_ = true;
     if (stream_ != nullptr) stream_->context->TryCancel();
-    changed_.notify_all();
+    changed_.SignalAll();
   }
   if (thread_.joinable()) thread_.join();
 }
@@ -77,33 +76,31 @@ absl::StatusOr<uint64_t> IngestSession::Send(Scan scan) {
   request->set_writer_id(writer_id_);
   uint64_t sequence;
   {
-    std::unique_lock lock(mutex_);
-    changed_.wait(
-        lock, [&] { return !error_.ok() || closing_ || stopping_ || pending_.size() < options_.max_unacknowledged; });
+    base::MutexLock lock(&mutex_);
+    while (error_.ok() && !closing_ && !stopping_ && pending_.size() >= options_.max_unacknowledged) {
+      changed_.Wait(&mutex_);
+    }
     if (!error_.ok()) return error_;
     if (closing_ || stopping_) return absl::FailedPreconditionError("the ingest session is closed: open a new one");
     sequence = next_sequence_++;
     request->set_sequence(sequence);
     pending_.push_back({sequence, std::move(request)});
     ++totals_.sent;
-    changed_.notify_all();  // the first batch makes the session's thread open the stream
+    changed_.SignalAll();  // the first batch makes the session's thread open the stream
   }
-  std::lock_guard write_lock(write_mutex_);
+  base::TimedMutexLock write_lock(&write_mutex_);
   WriteUnsentLocked();
   return sequence;
 }
 
 absl::Status IngestSession::Flush(absl::Duration timeout) {
-  std::unique_lock lock(mutex_);
-  const auto done = [&] { return pending_.empty() || !error_.ok() || stopping_; };
-  bool flushed = true;
-  if (timeout == absl::InfiniteDuration()) {
-    changed_.wait(lock, done);
-  } else {
-    flushed = changed_.wait_for(lock, absl::ToChronoNanoseconds(timeout), done);
+  const absl::Time deadline = absl::Now() + timeout;  // InfiniteFuture for InfiniteDuration: no limit
+  base::MutexLock lock(&mutex_);
+  while (!pending_.empty() && error_.ok() && !stopping_) {
+    if (changed_.WaitWithDeadline(&mutex_, deadline)) break;  // timed out
   }
   if (!error_.ok()) return error_;
-  if (!flushed || !pending_.empty()) {
+  if (!pending_.empty()) {
     return absl::DeadlineExceededError(absl::StrCat(pending_.size(), " batches of map \"", map_,
                                                     "\" not acknowledged after ", absl::FormatDuration(timeout),
                                                     " (is fremend at ", connection_->address(), " up?)"));
@@ -114,38 +111,38 @@ absl::Status IngestSession::Flush(absl::Duration timeout) {
 absl::Status IngestSession::Close(absl::Duration timeout) {
   absl::Status flushed = Flush(timeout);
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     closing_ = true;
-    changed_.notify_all();
+    changed_.SignalAll();
   }
   {
     // Ends our side of the stream; the daemon then ends the call with OK and the thread leaves.
-    std::lock_guard write_lock(write_mutex_);
+    base::TimedMutexLock write_lock(&write_mutex_);
     if (stream_ != nullptr && flushed.ok()) stream_->rw->WritesDone();
   }
   if (!flushed.ok()) {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     stopping_ = true;
     if (stream_ != nullptr) stream_->context->TryCancel();
-    changed_.notify_all();
+    changed_.SignalAll();
   }
   if (thread_.joinable()) thread_.join();
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   return flushed.ok() ? error_ : flushed;
 }
 
 std::vector<IngestAck> IngestSession::TakeAcks() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   return std::exchange(acks_, {});
 }
 
 IngestTotals IngestSession::totals() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   return totals_;
 }
 
 size_t IngestSession::unacknowledged() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   return pending_.size();
 }
 
@@ -154,14 +151,14 @@ std::shared_ptr<IngestSession::Stream> IngestSession::OpenStreamLocked() {
   // No deadline: the stream lives as long as the session; keepalive notices a dead link.
   stream->context = connection_->NewContext(absl::InfiniteFuture(), map_);
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     if (stopping_) return nullptr;
     if (generation_ > 0) ++totals_.reconnects;
     ++generation_;
   }
   stream->rw = connection_->ingest().Ingest(stream->context.get());
   {
-    std::lock_guard lock(mutex_);
+    base::MutexLock lock(&mutex_);
     stream_ = stream;
     // The destructor may have come between the two locks: it found no stream to cancel.
     if (stopping_) stream->context->TryCancel();
@@ -175,7 +172,7 @@ void IngestSession::WriteUnsentLocked() {
   for (;;) {
     std::shared_ptr<const v1::IngestRequest> next;
     {
-      std::lock_guard lock(mutex_);
+      base::MutexLock lock(&mutex_);
       for (Pending& pending : pending_) {
         if (pending.sent_on < generation_) {
           pending.sent_on = generation_;
@@ -214,12 +211,12 @@ void IngestSession::RecordLocked(IngestAck ack) {
   totals_.accepted += ack.accepted;
   totals_.rejected += ack.rejected;
   if (options_.collect_acks) acks_.push_back(std::move(ack));
-  changed_.notify_all();
+  changed_.SignalAll();
 }
 
 void IngestSession::FailLocked(absl::Status error) {
   if (error_.ok()) error_ = std::move(error);
-  changed_.notify_all();
+  changed_.SignalAll();
 }
 
 void IngestSession::Run() {
@@ -228,13 +225,13 @@ void IngestSession::Run() {
   for (;;) {
     {
       // Open a stream only when there is something to send.
-      std::unique_lock lock(mutex_);
-      changed_.wait(lock, [&] { return stopping_ || !error_.ok() || closing_ || !pending_.empty(); });
+      base::MutexLock lock(&mutex_);
+      while (!stopping_ && error_.ok() && !closing_ && pending_.empty()) changed_.Wait(&mutex_);
       if (stopping_ || !error_.ok() || (closing_ && pending_.empty())) return;
     }
     std::shared_ptr<Stream> stream;
     {
-      std::lock_guard write_lock(write_mutex_);
+      base::TimedMutexLock write_lock(&write_mutex_);
       stream = OpenStreamLocked();
     }
     if (stream == nullptr) return;
@@ -244,7 +241,7 @@ void IngestSession::Run() {
       IngestAck ack;
       absl::Status matched;
       {
-        std::lock_guard lock(mutex_);
+        base::MutexLock lock(&mutex_);
         matched = MatchLocked(response, ack);
         if (!matched.ok()) FailLocked(matched);
       }
@@ -256,20 +253,19 @@ void IngestSession::Run() {
       backoff.Reset();
       // Before the batch leaves pending_, so that a Flush that returned saw every callback.
       if (options_.on_ack) options_.on_ack(ack);
-      std::lock_guard lock(mutex_);
+      base::MutexLock lock(&mutex_);
       RecordLocked(std::move(ack));
     }
 
     // The stream has ended. Writes on it fail now; wait for a writer to return, then read the status.
-    std::unique_lock write_lock(write_mutex_, std::defer_lock);
-    if (!write_lock.try_lock_for(kWriterGrace)) {
+    if (!write_mutex_.TryLockFor(absl::ToChronoNanoseconds(kWriterGrace))) {
       stream->context->TryCancel();
-      write_lock.lock();
+      write_mutex_.Lock();
     }
     const absl::Status status = FromGrpcStatus(stream->rw->Finish(), connection_->address());
-    std::unique_lock lock(mutex_);
+    base::MutexLock lock(&mutex_);
     stream_.reset();
-    write_lock.unlock();
+    write_mutex_.Unlock();
     if (stopping_ || !error_.ok()) return;
     if (status.ok() && pending_.empty()) {
       if (closing_) return;
@@ -287,7 +283,10 @@ void IngestSession::Run() {
                                               " batches not acknowledged; last error: ", status.message())));
     }
     const absl::Duration delay = backoff.Next();
-    changed_.wait_for(lock, absl::ToChronoNanoseconds(delay), [&] { return stopping_; });
+    const absl::Time retry_at = absl::Now() + delay;
+    while (!stopping_) {
+      if (changed_.WaitWithDeadline(&mutex_, retry_at)) break;  // timed out
+    }
     if (stopping_) return;
   }
 }

@@ -33,22 +33,23 @@
 
 #include <grpcpp/grpcpp.h>
 
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "base/mutex.h"
 #include "client/lib/connection.h"
 #include "client/lib/scan_builder.h"
+
 #include "fremen/v1/ingest.grpc.pb.h"
 
 namespace fremen::client {
@@ -110,24 +111,24 @@ class IngestSession {
   static absl::StatusOr<std::unique_ptr<IngestSession>> Open(std::shared_ptr<Connection> connection, std::string map,
                                                              IngestOptions options = {});
   // Stops at once: batches not yet acknowledged are abandoned (call Close first to wait for them).
-  ~IngestSession();
+  ~IngestSession() ABSL_LOCKS_EXCLUDED(mutex_);
   IngestSession(const IngestSession&) = delete;
   IngestSession& operator=(const IngestSession&) = delete;
 
   // Queues the scan for sending and returns its sequence; blocks while max_unacknowledged batches
   // await their acks. The session's error once it has ended.
-  absl::StatusOr<uint64_t> Send(Scan scan);
+  absl::StatusOr<uint64_t> Send(Scan scan) ABSL_LOCKS_EXCLUDED(write_mutex_, mutex_);
   // Waits until every batch sent so far is acknowledged (DEADLINE_EXCEEDED after `timeout`,
   // naming how many are not), or the session's error.
-  absl::Status Flush(absl::Duration timeout = absl::InfiniteDuration());
+  absl::Status Flush(absl::Duration timeout = absl::InfiniteDuration()) ABSL_LOCKS_EXCLUDED(mutex_);
   // Flush, then ends the stream and the session's thread. Send fails afterwards.
-  absl::Status Close(absl::Duration timeout = absl::InfiniteDuration());
+  absl::Status Close(absl::Duration timeout = absl::InfiniteDuration()) ABSL_LOCKS_EXCLUDED(write_mutex_, mutex_);
 
   // The acks received since the last call, in sequence order (with collect_acks).
-  std::vector<IngestAck> TakeAcks();
-  IngestTotals totals() const;
+  std::vector<IngestAck> TakeAcks() ABSL_LOCKS_EXCLUDED(mutex_);
+  IngestTotals totals() const ABSL_LOCKS_EXCLUDED(mutex_);
   // Batches sent but not acknowledged.
-  size_t unacknowledged() const;
+  size_t unacknowledged() const ABSL_LOCKS_EXCLUDED(mutex_);
   uint64_t writer_id() const { return writer_id_; }
   // The sequence the first Send got (or gets).
   uint64_t first_sequence() const { return first_sequence_; }
@@ -148,19 +149,19 @@ class IngestSession {
                 uint64_t first_sequence);
 
   // The background thread: opens streams, reads acks, reconnects.
-  void Run();
-  // Opens a stream and writes every pending batch on it. REQUIRES: write_mutex_ held.
-  std::shared_ptr<Stream> OpenStreamLocked();
+  void Run() ABSL_LOCKS_EXCLUDED(write_mutex_, mutex_);
+  // Opens a stream and writes every pending batch on it.
+  std::shared_ptr<Stream> OpenStreamLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(write_mutex_) ABSL_LOCKS_EXCLUDED(mutex_);
   // Writes, in order, the pending batches not yet written on the current stream. Stops at a failed
-  // write (the reader notices the broken stream). REQUIRES: write_mutex_ held.
-  void WriteUnsentLocked();
+  // write (the reader notices the broken stream).
+  void WriteUnsentLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(write_mutex_) ABSL_LOCKS_EXCLUDED(mutex_);
   // The ack of the oldest pending batch from `response`; INTERNAL when it answers another batch.
-  // REQUIRES: mutex_ held.
-  absl::Status MatchLocked(const v1::IngestResponse& response, IngestAck& ack) const;
-  // The oldest pending batch is acknowledged: drop it, count it, keep the ack. REQUIRES: mutex_ held.
-  void RecordLocked(IngestAck ack);
-  // Ends the session with `error`. REQUIRES: mutex_ held.
-  void FailLocked(absl::Status error);
+  absl::Status MatchLocked(const v1::IngestResponse& response, IngestAck& ack) const
+      ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  // The oldest pending batch is acknowledged: drop it, count it, keep the ack.
+  void RecordLocked(IngestAck ack) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // Ends the session with `error`.
+  void FailLocked(absl::Status error) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
 
   const std::shared_ptr<Connection> connection_;
   const std::string map_;
@@ -168,20 +169,24 @@ class IngestSession {
   const uint64_t writer_id_;
   const uint64_t first_sequence_;
 
-  // Held while writing to the stream and while replacing it; taken before mutex_, never after.
-  std::timed_mutex write_mutex_;
-  std::shared_ptr<Stream> stream_;  // written with both mutexes held, read with either
-  uint64_t generation_ = 0;         // guarded by both: written with both held, read with either
+  // Held while writing to the stream and while replacing it; taken before mutex_, never after
+  // (ABSL_ACQUIRED_BEFORE says so, though clang 14 does not check it). Timed: the reader waits for
+  // a writer only so long before cancelling the call that blocks it.
+  base::TimedMutex write_mutex_ ABSL_ACQUIRED_BEFORE(mutex_);
+  // Written with both mutexes held, read with either: a rule the analysis cannot express (its
+  // ABSL_GUARDED_BY takes one mutex for reads and writes alike), so these two are not annotated.
+  std::shared_ptr<Stream> stream_;
+  uint64_t generation_ = 0;
 
-  mutable std::mutex mutex_;
-  std::condition_variable changed_;
-  std::deque<Pending> pending_;
-  uint64_t next_sequence_;
-  std::vector<IngestAck> acks_;
-  IngestTotals totals_;
-  absl::Status error_;     // the session has ended with this
-  bool closing_ = false;   // Close: no more Send
-  bool stopping_ = false;  // destructor: leave now
+  mutable base::Mutex mutex_;
+  base::CondVar changed_;
+  std::deque<Pending> pending_ ABSL_GUARDED_BY(mutex_);
+  uint64_t next_sequence_ ABSL_GUARDED_BY(mutex_);
+  std::vector<IngestAck> acks_ ABSL_GUARDED_BY(mutex_);
+  IngestTotals totals_ ABSL_GUARDED_BY(mutex_);
+  absl::Status error_ ABSL_GUARDED_BY(mutex_);     // the session has ended with this
+  bool closing_ ABSL_GUARDED_BY(mutex_) = false;   // Close: no more Send
+  bool stopping_ ABSL_GUARDED_BY(mutex_) = false;  // destructor: leave now
 
   std::thread thread_;
 };

@@ -20,7 +20,7 @@ class FaultInjectionEnv::File : public WritableFile {
       : env_(env), path_(std::move(path)), base_(std::move(base)) {}
 
   absl::Status Append(std::span<const uint8_t> data) override {
-    std::lock_guard lock(env_->mutex_);
+    base::MutexLock lock(&env_->mutex_);
     if (absl::Status s = env_->EnterLocked(); !s.ok()) return s;
     return env_->AppendLocked(path_, *base_, data);
   }
@@ -29,7 +29,7 @@ class FaultInjectionEnv::File : public WritableFile {
     if (env_->before_sync_) {
       if (absl::Status s = env_->before_sync_(); !s.ok()) return s;
     }
-    std::lock_guard lock(env_->mutex_);
+    base::MutexLock lock(&env_->mutex_);
     if (absl::Status s = env_->EnterLocked(); !s.ok()) return s;
     return env_->SyncLocked(path_, *base_);
   }
@@ -47,50 +47,50 @@ FaultInjectionEnv::FaultInjectionEnv(uint64_t seed, Env* base) : base_(base), rn
 FaultInjectionEnv::~FaultInjectionEnv() = default;
 
 void FaultInjectionEnv::FailSyncs(int errno_value) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   sync_errno_ = errno_value;
 }
 
 void FaultInjectionEnv::set_before_sync(std::function<absl::Status()> hook) { before_sync_ = std::move(hook); }
 
 void FaultInjectionEnv::FailWrites(int errno_value) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   write_errno_ = errno_value;
 }
 
 void FaultInjectionEnv::TearNextWrite() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   tear_next_write_ = true;
 }
 
 void FaultInjectionEnv::CutPower() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (!power_cut_) CutPowerLocked();
 }
 
 void FaultInjectionEnv::CutPowerAfter(uint64_t operations) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   cut_at_ = operations == 0 ? 0 : operations_ + operations;
 }
 
 void FaultInjectionEnv::set_tear_at_cut(bool tear) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   tear_at_cut_ = tear;
 }
 
 bool FaultInjectionEnv::power_cut() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   return power_cut_;
 }
 
 void FaultInjectionEnv::PowerOn() {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   power_cut_ = false;
   cut_at_ = 0;
 }
 
 uint64_t FaultInjectionEnv::operations() const {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   return operations_;
 }
 
@@ -186,7 +186,7 @@ absl::Status FaultInjectionEnv::SyncLocked(const std::string& path, WritableFile
 }
 
 absl::StatusOr<std::unique_ptr<WritableFile>> FaultInjectionEnv::NewWritableFile(const std::string& path) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = EnterLocked(); !s.ok()) return s;
   auto file = base_->NewWritableFile(path);
   if (!file.ok()) return file.status();
@@ -196,7 +196,7 @@ absl::StatusOr<std::unique_ptr<WritableFile>> FaultInjectionEnv::NewWritableFile
 }
 
 absl::StatusOr<std::unique_ptr<WritableFile>> FaultInjectionEnv::NewAppendableFile(const std::string& path) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = EnterLocked(); !s.ok()) return s;
   auto file = base_->NewAppendableFile(path);
   if (!file.ok()) return file.status();
@@ -210,19 +210,19 @@ absl::StatusOr<std::unique_ptr<WritableFile>> FaultInjectionEnv::NewAppendableFi
 }
 
 absl::StatusOr<std::string> FaultInjectionEnv::ReadFile(const std::string& path) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = LiveLocked(); !s.ok()) return s;
   return base_->ReadFile(path);
 }
 
 absl::StatusOr<uint64_t> FaultInjectionEnv::FileSize(const std::string& path) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = LiveLocked(); !s.ok()) return s;
   return base_->FileSize(path);
 }
 
 absl::StatusOr<std::vector<std::string>> FaultInjectionEnv::ListDir(const std::string& dir) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = LiveLocked(); !s.ok()) return s;
   auto names = base_->ListDir(dir);
   if (names.ok()) {
@@ -234,13 +234,13 @@ absl::StatusOr<std::vector<std::string>> FaultInjectionEnv::ListDir(const std::s
 absl::Status FaultInjectionEnv::CreateDir(const std::string& dir) {
   // Directories are taken as durable at once: the store creates them before it writes anything that
   // matters, and syncs the files in them.
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = EnterLocked(); !s.ok()) return s;
   return base_->CreateDir(dir);
 }
 
 absl::Status FaultInjectionEnv::Truncate(const std::string& path, uint64_t size) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = EnterLocked(); !s.ok()) return s;
   if (absl::Status s = base_->Truncate(path, size); !s.ok()) return s;
   files_[path] = FileState{size, size};  // Truncate is durable (env.h)
@@ -248,7 +248,7 @@ absl::Status FaultInjectionEnv::Truncate(const std::string& path, uint64_t size)
 }
 
 absl::Status FaultInjectionEnv::Unlink(const std::string& path) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = EnterLocked(); !s.ok()) return s;
   if (auto size = base_->FileSize(path); !size.ok()) return size.status();
   const std::string aside = AsideNameLocked(path);
@@ -259,7 +259,7 @@ absl::Status FaultInjectionEnv::Unlink(const std::string& path) {
 }
 
 absl::Status FaultInjectionEnv::Rename(const std::string& from, const std::string& to) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = EnterLocked(); !s.ok()) return s;
   std::string aside;
   if (base_->FileSize(to).ok()) {
@@ -274,7 +274,7 @@ absl::Status FaultInjectionEnv::Rename(const std::string& from, const std::strin
 }
 
 absl::Status FaultInjectionEnv::SyncDir(const std::string& dir) {
-  std::lock_guard lock(mutex_);
+  base::MutexLock lock(&mutex_);
   if (absl::Status s = EnterLocked(); !s.ok()) return s;
   if (sync_errno_ != 0) return IoError(sync_errno_, absl::StrCat("fsync ", dir, " (injected)"));
   if (absl::Status s = base_->SyncDir(dir); !s.ok()) return s;

@@ -21,12 +21,13 @@
 
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
+#include "base/mutex.h"
 #include "storage/env/env.h"
 
 namespace fremen::storage {
@@ -90,28 +91,30 @@ class FaultInjectionEnv : public Env {
   };
 
   // Counts a changing operation; cuts the power when due. An error: refuse the operation.
-  absl::Status EnterLocked();
-  absl::Status LiveLocked() const;
-  void CutPowerLocked();
-  std::string AsideNameLocked(const std::string& path);
-  void MoveStateLocked(const std::string& from, const std::string& to);
-  absl::Status AppendLocked(const std::string& path, WritableFile& base, std::span<const uint8_t> data);
-  absl::Status SyncLocked(const std::string& path, WritableFile& base);
+  absl::Status EnterLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  absl::Status LiveLocked() const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  void CutPowerLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  std::string AsideNameLocked(const std::string& path) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  void MoveStateLocked(const std::string& from, const std::string& to) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  absl::Status AppendLocked(const std::string& path, WritableFile& base, std::span<const uint8_t> data)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  absl::Status SyncLocked(const std::string& path, WritableFile& base) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
 
   Env* const base_;
-  mutable std::mutex mutex_;
-  std::mt19937_64 rng_;
-  int sync_errno_ = 0;
-  int write_errno_ = 0;
-  bool tear_next_write_ = false;
+  mutable base::Mutex mutex_;
+  std::mt19937_64 rng_ ABSL_GUARDED_BY(mutex_);
+  int sync_errno_ ABSL_GUARDED_BY(mutex_) = 0;
+  int write_errno_ ABSL_GUARDED_BY(mutex_) = 0;
+  bool tear_next_write_ ABSL_GUARDED_BY(mutex_) = false;
   std::function<absl::Status()> before_sync_;  // set before the env is used
-  bool tear_at_cut_ = false;
-  bool power_cut_ = false;
-  uint64_t operations_ = 0;
-  uint64_t cut_at_ = 0;  // operations_ value at which to cut; 0: none
-  uint64_t aside_counter_ = 0;
-  absl::flat_hash_map<std::string, FileState> files_;
-  absl::flat_hash_map<std::string, std::vector<DirOp>> pending_;  // by directory, oldest first
+  bool tear_at_cut_ ABSL_GUARDED_BY(mutex_) = false;
+  bool power_cut_ ABSL_GUARDED_BY(mutex_) = false;
+  uint64_t operations_ ABSL_GUARDED_BY(mutex_) = 0;
+  uint64_t cut_at_ ABSL_GUARDED_BY(mutex_) = 0;  // operations_ value at which to cut; 0: none
+  uint64_t aside_counter_ ABSL_GUARDED_BY(mutex_) = 0;
+  absl::flat_hash_map<std::string, FileState> files_ ABSL_GUARDED_BY(mutex_);
+  // By directory, oldest first.
+  absl::flat_hash_map<std::string, std::vector<DirOp>> pending_ ABSL_GUARDED_BY(mutex_);
 };
 
 }  // namespace fremen::storage

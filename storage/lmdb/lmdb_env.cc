@@ -225,12 +225,12 @@ absl::StatusOr<std::unique_ptr<LmdbEnv>> LmdbEnv::Open(const std::string& dir, c
 LmdbEnv::~LmdbEnv() { mdb_env_close(env_); }
 
 absl::Status LmdbEnv::health() const {
-  std::lock_guard lock(latch_mutex_);
+  base::MutexLock lock(&latch_mutex_);
   return latched_;
 }
 
 void LmdbEnv::Latch(const absl::Status& status) {
-  std::lock_guard lock(latch_mutex_);
+  base::MutexLock lock(&latch_mutex_);
   if (latched_.ok()) latched_ = status;
 }
 
@@ -244,7 +244,7 @@ absl::Status LmdbEnv::Grow() {
 }
 
 absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {
-  std::lock_guard writer(writer_);
+  base::MutexLock writer(&writer_);
   if (read_only_) return absl::FailedPreconditionError(absl::StrCat(dir_, " is open for reading only"));
   if (absl::Status latched = health(); !latched.ok()) return latched;
   for (;;) {

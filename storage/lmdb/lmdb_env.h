@@ -27,17 +27,18 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "absl/synchronization/mutex.h"
+#include "base/mutex.h"
 
 namespace fremen::storage {
 
@@ -135,7 +136,7 @@ class LmdbEnv {
   // Runs f in a write transaction and commits it. f may run more than once (after map growth) and
   // must not have effects outside the transaction until Write returns OK. A non-OK status from f
   // aborts the transaction and is returned.
-  absl::Status Write(const std::function<absl::Status(LmdbTxn&)>& f);
+  absl::Status Write(const std::function<absl::Status(LmdbTxn&)>& f) ABSL_LOCKS_EXCLUDED(writer_, resize_);
   // Runs f in a read-only snapshot.
   absl::Status Read(const std::function<absl::Status(LmdbTxn&)>& f) const;
 
@@ -146,36 +147,42 @@ class LmdbEnv {
   // A consistent copy (compacted) into an existing empty directory, while writers go on.
   absl::Status CopyTo(const std::string& dir) const;
 
-  size_t map_size() const { return map_size_; }
+  size_t map_size() const ABSL_LOCKS_EXCLUDED(resize_) {
+    absl::ReaderMutexLock lock(&resize_);
+    return map_size_;
+  }
   // Bytes of the data file in use (pages up to the last one written).
   absl::StatusOr<size_t> UsedBytes() const;
   const std::string& dir() const { return dir_; }
   // <dir>/data.mdb, as errors name it.
   const std::string& file() const { return file_; }
   // The latched error of a failed commit or sync, OK when healthy.
-  absl::Status health() const;
+  absl::Status health() const ABSL_LOCKS_EXCLUDED(latch_mutex_);
 
  private:
   LmdbEnv(MDB_env* env, std::string dir, size_t map_size)
       : env_(env), dir_(std::move(dir)), file_(dir_ + "/data.mdb"), map_size_(map_size) {}
-  absl::Status Grow();
+  absl::Status Grow() ABSL_LOCKS_EXCLUDED(resize_);
   absl::Status OpenDatabases(const std::vector<std::string>& names, bool read_only);
   // Writes the record format marker into a new environment (a writable one); refuses one of
   // another format.
   absl::Status CheckRecordFormat(LmdbTxn& txn, bool read_only);
-  void Latch(const absl::Status& status);
+  void Latch(const absl::Status& status) ABSL_LOCKS_EXCLUDED(latch_mutex_);
 
   MDB_env* env_;
   std::string dir_;
   std::string file_;
-  size_t map_size_;
-  std::mutex writer_;                 // one write transaction at a time
+  size_t map_size_ ABSL_GUARDED_BY(resize_);
+  base::Mutex writer_;  // guards no member: one write transaction at a time
   // Read transactions (and the write transaction) shared, map growth exclusive. absl::Mutex, not
-  // std::shared_mutex: glibc's rwlock prefers readers, so a steady stream of reads starved Grow (and
-  // the writer behind it) indefinitely; absl::Mutex makes new readers wait behind a waiting Grow.
+  // std::shared_mutex (nor base::SharedMutex, which is one): glibc's rwlock prefers readers, so a
+  // steady stream of reads starved Grow (and the writer behind it) indefinitely; absl::Mutex makes
+  // new readers wait behind a waiting Grow. It is the one lock TSan cannot see (base/mutex.h says
+  // why): what it orders is liblmdb's own state, which TSan does not see either, and map_size_,
+  // which only Grow writes, with writer_ (a lock TSan sees) held as well.
   mutable absl::Mutex resize_;
-  mutable std::mutex latch_mutex_;
-  absl::Status latched_;
+  mutable base::Mutex latch_mutex_;
+  absl::Status latched_ ABSL_GUARDED_BY(latch_mutex_);
   DbHandles dbs_;  // written once, at Open
   std::vector<std::string> absent_;  // declared databases a read-only file does not hold
   bool read_only_ = false;

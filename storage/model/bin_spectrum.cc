@@ -3,10 +3,12 @@
 #include <fftw3.h>
 
 #include <algorithm>
-#include <mutex>
 #include <type_traits>
 #include <utility>
 #include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "base/mutex.h"
 
 namespace fremen::model {
 
@@ -18,8 +20,8 @@ using Plan = std::shared_ptr<std::remove_pointer_t<fftw_plan>>;
 // Lengths differ from state to state, so only the most recently used few plans are kept.
 struct PlanCache {
   static constexpr size_t kMaxPlans = 16;
-  std::mutex mu;
-  std::vector<std::pair<int, Plan>> plans;  // most recently used last
+  base::Mutex mu;
+  std::vector<std::pair<int, Plan>> plans ABSL_GUARDED_BY(mu);  // most recently used last
 };
 
 PlanCache& Cache() {
@@ -33,7 +35,7 @@ PlanCache& Cache() {
 Plan InPlaceR2cPlan(int n, double* buffer) {
   PlanCache& cache = Cache();
   Plan evicted;  // released after the lock: its deleter takes the lock
-  std::lock_guard<std::mutex> lock(cache.mu);
+  base::MutexLock lock(&cache.mu);
   auto it = std::find_if(cache.plans.begin(), cache.plans.end(), [n](const auto& e) { return e.first == n; });
   if (it != cache.plans.end()) {
     std::rotate(it, it + 1, cache.plans.end());
@@ -41,7 +43,7 @@ Plan InPlaceR2cPlan(int n, double* buffer) {
   }
   Plan plan(fftw_plan_dft_r2c_1d(n, buffer, reinterpret_cast<fftw_complex*>(buffer), FFTW_ESTIMATE),
             [](fftw_plan p) {
-              std::lock_guard<std::mutex> l(Cache().mu);
+              base::MutexLock l(&Cache().mu);
               fftw_destroy_plan(p);
             });
   if (cache.plans.size() == PlanCache::kMaxPlans) {

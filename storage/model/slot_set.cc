@@ -213,7 +213,10 @@ uint64_t CountCommon(const SlotSet& a, const SlotSet& b, uint64_t begin, uint64_
   SlotSet::Cursor ca(a), cb(b);
   uint64_t x = begin;
   while (x < end) {
-    const bool both = ca.Seek(x) & cb.Seek(x);
+    // Both cursors move to x, whatever the first answers.
+    const bool in_a = ca.Seek(x);
+    const bool in_b = cb.Seek(x);
+    const bool both = in_a && in_b;
     const uint64_t run_end = std::min({ca.next_change(), cb.next_change(), end});
     if (both) count += run_end - x;
     x = run_end;
