@@ -261,7 +261,7 @@ absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {
         if (!wrapped.map_full()) return status;
         rc = MDB_MAP_FULL;
       } else {
-        rc = mdb_txn_commit(txn);
+        rc = Commit(txn);
         if (rc == MDB_SUCCESS) return absl::OkStatus();
       }
     }
@@ -275,10 +275,30 @@ absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {
   }
 }
 
+int LmdbEnv::Commit(MDB_txn* txn) {
+  commits_started_.fetch_add(1);
+  const int rc = mdb_txn_commit(txn);
+  commits_ended_.fetch_add(1);
+  return rc;
+}
+
+int LmdbEnv::BeginSnapshot(MDB_txn** txn) const {
+  for (;;) {
+    // Commits ended before the begin: the snapshot chosen is at least the last of them, T, and T's
+    // meta page is next written by the second commit after it.
+    const uint64_t ended = commits_ended_.load();
+    const int rc = mdb_txn_begin(env_, nullptr, MDB_RDONLY, txn);
+    if (rc != MDB_SUCCESS) return rc;
+    std::atomic_thread_fence(std::memory_order_seq_cst);  // the page copy above comes before this load
+    if (commits_started_.load() - ended < 2) return MDB_SUCCESS;
+    mdb_txn_abort(*txn);
+  }
+}
+
 absl::Status LmdbEnv::Read(const std::function<absl::Status(LmdbTxn&)>& f) const {
   absl::ReaderMutexLock lock(&resize_);
   MDB_txn* txn;
-  const int rc = mdb_txn_begin(env_, nullptr, MDB_RDONLY, &txn);
+  const int rc = BeginSnapshot(&txn);
   if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_txn_begin (read)");
   LmdbTxn wrapped(txn, &dbs_, &file_, &absent_);
   absl::Status status = f(wrapped);

@@ -137,7 +137,7 @@ class LmdbEnv {
   // must not have effects outside the transaction until Write returns OK. A non-OK status from f
   // aborts the transaction and is returned.
   absl::Status Write(const std::function<absl::Status(LmdbTxn&)>& f) ABSL_LOCKS_EXCLUDED(writer_, resize_);
-  // Runs f in a read-only snapshot.
+  // Runs f in a read-only snapshot, never older than one an earlier Read of this process saw.
   absl::Status Read(const std::function<absl::Status(LmdbTxn&)>& f) const;
 
   // Flushes to disk (for no_sync environments).
@@ -168,12 +168,21 @@ class LmdbEnv {
   // another format.
   absl::Status CheckRecordFormat(LmdbTxn& txn, bool read_only);
   void Latch(const absl::Status& status) ABSL_LOCKS_EXCLUDED(latch_mutex_);
+  // mdb_txn_commit, counted for BeginSnapshot.
+  int Commit(MDB_txn* txn);
+  // A read transaction whose snapshot is the one its txnid names (docs/storage.md, "Read
+  // snapshots"): liblmdb copies the snapshot's roots from the meta page of its txnid after
+  // choosing it, and a writer two commits further overwrites that page, so a reader preempted
+  // in between could see a newer snapshot than the next reader, or a torn mix. A begin with two
+  // commits started during it is retried.
+  int BeginSnapshot(MDB_txn** txn) const;
 
   MDB_env* env_;
   std::string dir_;
   std::string file_;
   size_t map_size_ ABSL_GUARDED_BY(resize_);
   base::Mutex writer_;  // guards no member: one write transaction at a time
+  std::atomic<uint64_t> commits_started_ = 0, commits_ended_ = 0;  // of Commit
   // Read transactions (and the write transaction) shared, map growth exclusive. absl::Mutex, not
   // std::shared_mutex (nor base::SharedMutex, which is one): glibc's rwlock prefers readers, so a
   // steady stream of reads starved Grow (and the writer behind it) indefinitely; absl::Mutex makes
