@@ -10,6 +10,7 @@
 
 #include "storage/env/fault_injection_env.h"
 #include "storage/map_store.h"
+#include "storage/testing/open_map_store.h"
 #include "storage/testing/scans.h"
 #include "testing/temp_dir.h"
 
@@ -17,17 +18,12 @@ namespace fremen::storage {
 namespace {
 
 using testing::GridMap;
+using testing::OpenOrDie;
 using testing::SweepScan;
 using fremen::testing::TempDir;
 
 constexpr uint64_t kWriter = 7;
 constexpr size_t kCells = 50;
-
-std::unique_ptr<MapStore> OpenOrDie(const MapInfo& info, const std::string& dir, StoreOptions options = {}) {
-  auto store = MapStore::Open(info, dir, options);
-  EXPECT_TRUE(store.ok()) << store.status();
-  return store.ok() ? *std::move(store) : nullptr;
-}
 
 // Batch `sequence` of kWriter; another `seed` gives other content under the same sequence.
 ObservationBatch Scan(const MapInfo& map, uint64_t sequence, uint64_t seed = 1) {

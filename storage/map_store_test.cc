@@ -10,6 +10,7 @@
 #include "storage/model/compact_models.h"
 #include "storage/model/phasor.h"
 #include "storage/model/region_predict.h"
+#include "storage/testing/open_map_store.h"
 #include "storage/testing/scans.h"
 #include "testing/temp_dir.h"
 
@@ -17,14 +18,9 @@ namespace fremen::storage {
 namespace {
 
 using testing::GridMap;
+using testing::OpenOrDie;
 using testing::SweepScan;
 using fremen::testing::TempDir;
-
-std::unique_ptr<MapStore> OpenOrDie(const MapInfo& info, const std::string& dir, StoreOptions options = {}) {
-  auto store = MapStore::Open(info, dir, options);
-  EXPECT_TRUE(store.ok()) << store.status();
-  return store.ok() ? *std::move(store) : nullptr;
-}
 
 // Every state's model, as a comparable string of its encodings.
 void ExpectSameModels(const MapStore& a, const MapStore& b, const MapInfo& map) {

@@ -15,6 +15,7 @@
 #include "storage/map_store.h"
 #include "storage/model/lossless_history.h"
 #include "storage/model/record_codec.h"
+#include "storage/testing/open_map_store.h"
 #include "storage/testing/scans.h"
 #include "testing/temp_dir.h"
 
@@ -22,15 +23,10 @@ namespace fremen::storage {
 namespace {
 
 using testing::GridMap;
+using testing::OpenOrDie;
 using fremen::testing::TempDir;
 
 constexpr double kT0 = 1.7e9;
-
-std::unique_ptr<MapStore> OpenOrDie(const MapInfo& info, const std::string& dir, StoreOptions options = {}) {
-  auto store = MapStore::Open(info, dir, options);
-  EXPECT_TRUE(store.ok()) << store.status();
-  return store.ok() ? *std::move(store) : nullptr;
-}
 
 // Every cell of z-planes [z0, z1) (rows y < `rows` of them) at time t: value 1 where (x + y + i) is
 // even, else 0, so that two scans make every cell dynamic.

@@ -20,6 +20,7 @@
 #include "fremen/v1/query.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "tests/fremend_fixture.h"
+#include "tests/map_specs.h"
 #include "tests/store_writer.h"
 
 namespace fremen::testing {
@@ -36,22 +37,9 @@ using Metadata = std::vector<std::pair<std::string, std::string>>;
 constexpr double kT0 = 1'700'006'400;  // a Monday 00:00 UTC; any origin would do
 constexpr double kDay = 86400;
 
-v1::Map GenericMap(const std::string& name) {
-  v1::Map map;
-  map.set_name(name);
-  map.set_kind(v1::MAP_KIND_GENERIC);
-  return map;
-}
+v1::Map GenericMap(const std::string& name) { return GenericMapSpec(name); }
 
-v1::Map GridMap(const std::string& name, uint32_t nx, uint32_t ny) {
-  v1::Map map;
-  map.set_name(name);
-  map.set_kind(v1::MAP_KIND_GRID);
-  map.mutable_grid()->set_resolution(0.05);
-  map.mutable_grid()->mutable_size()->set_x(nx);
-  map.mutable_grid()->mutable_size()->set_y(ny);
-  return map;
-}
+v1::Map GridMap(const std::string& name, uint32_t nx, uint32_t ny) { return GridMapSpec(name, nx, ny, 0.05); }
 
 class AdminServiceTest : public DaemonTest {
  protected:

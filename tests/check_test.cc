@@ -19,6 +19,7 @@
 #include "client/lib/client.h"
 #include "fremen/v1/admin.grpc.pb.h"
 #include "tests/fremend_fixture.h"
+#include "tests/map_specs.h"
 
 namespace fremen::testing {
 namespace {
@@ -76,13 +77,7 @@ class CheckTest : public DaemonTest {
   // A grid of nx × ny cells, every one changed (`scans` scans of alternating patches), so that its
   // shard holds many LMDB pages.
   void MakeGrid(const std::string& map, uint32_t nx, uint32_t ny, int scans) {
-    v1::Map m;
-    m.set_name(map);
-    m.set_kind(v1::MAP_KIND_GRID);
-    m.mutable_grid()->set_resolution(0.1);
-    m.mutable_grid()->mutable_size()->set_x(nx);
-    m.mutable_grid()->mutable_size()->set_y(ny);
-    ASSERT_TRUE(client_->CreateMap(m).ok());
+    ASSERT_TRUE(client_->CreateMap(GridMapSpec(map, nx, ny, 0.1)).ok());
     auto session = client_->OpenIngest(map);
     ASSERT_TRUE(session.ok()) << session.status();
     for (int i = 0; i < scans; ++i) {

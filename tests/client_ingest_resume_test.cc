@@ -9,9 +9,12 @@
 #include <cstdio>
 #include <thread>
 
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "client/lib/client.h"
 #include "tests/fremend_fixture.h"
+#include "tests/map_specs.h"
 
 namespace fremen::testing {
 namespace {
@@ -37,21 +40,21 @@ class ClientIngestResumeTest : public DaemonTest {
     // Quick retries: the daemon is back within a second or two.
     options.retry.max_backoff = absl::Milliseconds(250);
     client_.emplace(*Client::Connect(options));
-    v1::Map map;
-    map.set_name("doors");
-    map.set_kind(v1::MAP_KIND_GENERIC);
+    v1::Map map = GenericMapSpec("doors");
     map.set_shards(2);
     ASSERT_TRUE(client_->CreateMap(map).ok());
   }
 
-  // Sends batches [from, to): batch i observes every state at time kStart + 60 i.
-  void SendBatches(IngestSession& session, int from, int to) {
+  // Sends batches [from, to): batch i observes every state at time kStart + 60 i. The first failed
+  // send, naming its batch; a status rather than an assertion, as a sender thread calls it too.
+  static absl::Status SendBatches(IngestSession& session, int from, int to) {
     for (int i = from; i < to; ++i) {
       ScanBuilder scan(kStart + 60.0 * i);
       for (uint64_t id = 1; id <= kStates; ++id) scan.AddState(id, static_cast<float>((i + id) % 2));
       auto sent = session.Send(*scan.Build());
-      ASSERT_TRUE(sent.ok()) << "batch " << i << ": " << sent.status();
+      if (!sent.ok()) return absl::Status(sent.status().code(), absl::StrCat("batch ", i, ": ", sent.status().message()));
     }
+    return absl::OkStatus();
   }
 
   std::string address_;
@@ -66,14 +69,14 @@ TEST_F(ClientIngestResumeTest, EveryBatchIsAppliedExactlyOnceAcrossRestartsAndAK
   auto session = client_->OpenIngest("doors", options);
   ASSERT_TRUE(session.ok()) << session.status();
 
-  SendBatches(**session, 0, kBatchesPerPhase);
+  ASSERT_EQ(SendBatches(**session, 0, kBatchesPerPhase), absl::OkStatus());
   // Batches in flight when the daemon goes away: what the session must resend.
   size_t in_flight = (*session)->unacknowledged();
   // SIGTERM: the daemon answers what it has, ends the stream with UNAVAILABLE and exits.
   StopDaemon();
   StartDaemon({"--listen", address_});
   ASSERT_FALSE(HasFatalFailure());
-  SendBatches(**session, kBatchesPerPhase, 2 * kBatchesPerPhase);
+  ASSERT_EQ(SendBatches(**session, kBatchesPerPhase, 2 * kBatchesPerPhase), absl::OkStatus());
   // kill -9 with batches in flight: some were applied but not acknowledged (resent, recognised as
   // duplicates), some never reached the store (resent, applied).
   in_flight += (*session)->unacknowledged();
@@ -81,7 +84,7 @@ TEST_F(ClientIngestResumeTest, EveryBatchIsAppliedExactlyOnceAcrossRestartsAndAK
   daemon_.reset();
   StartDaemon({"--listen", address_});
   ASSERT_FALSE(HasFatalFailure());
-  SendBatches(**session, 2 * kBatchesPerPhase, 3 * kBatchesPerPhase);
+  ASSERT_EQ(SendBatches(**session, 2 * kBatchesPerPhase, 3 * kBatchesPerPhase), absl::OkStatus());
   ASSERT_TRUE((*session)->Close(absl::Seconds(120)).ok());
 
   const auto totals = (*session)->totals();
@@ -115,7 +118,7 @@ TEST_F(ClientIngestResumeTest, ARebootedWriterContinuesAfterItsLastSequenceAndLo
     auto session = client_->OpenIngest("doors", options);
     ASSERT_TRUE(session.ok()) << session.status();
     EXPECT_EQ((*session)->first_sequence(), 1u);
-    SendBatches(**session, 0, 10);
+    ASSERT_EQ(SendBatches(**session, 0, 10), absl::OkStatus());
     ASSERT_TRUE((*session)->Close(absl::Seconds(60)).ok());
   }
   // Rebooted, and the daemon restarted meanwhile too: the session asks where to continue.
@@ -125,7 +128,7 @@ TEST_F(ClientIngestResumeTest, ARebootedWriterContinuesAfterItsLastSequenceAndLo
   auto rebooted = client_->OpenIngest("doors", options);
   ASSERT_TRUE(rebooted.ok()) << rebooted.status();
   EXPECT_EQ((*rebooted)->first_sequence(), 11u);
-  SendBatches(**rebooted, 10, 20);
+  ASSERT_EQ(SendBatches(**rebooted, 10, 20), absl::OkStatus());
   ASSERT_TRUE((*rebooted)->Close(absl::Seconds(60)).ok());
   const auto totals = (*rebooted)->totals();
   EXPECT_EQ(totals.acknowledged, 10u);
@@ -143,7 +146,7 @@ TEST_F(ClientIngestResumeTest, ARebootedWriterContinuesAfterItsLastSequenceAndLo
   options.first_sequence = 1;
   auto counting_again = client_->OpenIngest("doors", options);
   ASSERT_TRUE(counting_again.ok()) << counting_again.status();
-  SendBatches(**counting_again, 20, 21);
+  ASSERT_EQ(SendBatches(**counting_again, 20, 21), absl::OkStatus());
   ASSERT_TRUE((*counting_again)->Close(absl::Seconds(60)).ok());
   const std::vector<client::IngestAck> acks = (*counting_again)->TakeAcks();
   ASSERT_EQ(acks.size(), 1u);
@@ -166,10 +169,13 @@ TEST_F(ClientIngestResumeTest, ASenderThreadKeepsSendingThroughAKillAndARestart)
   auto session = client_->OpenIngest("doors", options);
   ASSERT_TRUE(session.ok()) << session.status();
   constexpr int kBatches = 4 * kBatchesPerPhase;
-  std::thread sender([&] { SendBatches(**session, 0, kBatches); });
+  absl::Status sent;  // the sender's, read once it has been joined
+  std::thread sender([&] { sent = SendBatches(**session, 0, kBatches); });
   const auto await_acks = [&](uint64_t n) {
     const absl::Time give_up = absl::Now() + absl::Seconds(120);
     while ((*session)->totals().acknowledged < n && absl::Now() < give_up) absl::SleepFor(absl::Milliseconds(1));
+    // Without this the daemon would be killed at another point than the one the test is about.
+    EXPECT_GE((*session)->totals().acknowledged, n) << "the sender did not reach " << n << " acks in 2 minutes";
   };
   await_acks(kBatches / 4);
   daemon_->Kill();
@@ -179,6 +185,7 @@ TEST_F(ClientIngestResumeTest, ASenderThreadKeepsSendingThroughAKillAndARestart)
   StopDaemon();
   StartDaemon({"--listen", address_});
   sender.join();
+  ASSERT_TRUE(sent.ok()) << sent;
   ASSERT_FALSE(HasFatalFailure());
   ASSERT_TRUE((*session)->Close(absl::Seconds(120)).ok());
 
@@ -200,11 +207,11 @@ TEST_F(ClientIngestResumeTest, SessionGivesUpAfterItsReconnectTimeout) {
   options.reconnect_timeout = absl::Seconds(2);
   auto session = client_->OpenIngest("doors", options);
   ASSERT_TRUE(session.ok()) << session.status();
-  SendBatches(**session, 0, 3);
+  ASSERT_EQ(SendBatches(**session, 0, 3), absl::OkStatus());
   ASSERT_TRUE((*session)->Flush(absl::Seconds(30)).ok());
   daemon_->Kill();
   daemon_.reset();
-  SendBatches(**session, 3, 5);
+  ASSERT_EQ(SendBatches(**session, 3, 5), absl::OkStatus());
   absl::Status flushed = (*session)->Flush(absl::Seconds(60));
   EXPECT_EQ(flushed.code(), absl::StatusCode::kUnavailable) << flushed;
   EXPECT_THAT(flushed.message(), ::testing::HasSubstr("gave up reconnecting"));

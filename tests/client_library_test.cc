@@ -13,6 +13,7 @@
 #include "absl/time/clock.h"
 #include "client/lib/client.h"
 #include "tests/fremend_fixture.h"
+#include "tests/map_specs.h"
 
 namespace fremen::testing {
 namespace {
@@ -33,20 +34,13 @@ constexpr double kDay = 86400;
 constexpr double kStart = 1699920000;
 
 v1::Map GridMap(const std::string& name, uint32_t x = 20, uint32_t y = 10) {
-  v1::Map map;
-  map.set_name(name);
-  map.set_kind(v1::MAP_KIND_GRID);
-  map.mutable_grid()->set_resolution(0.5);
-  map.mutable_grid()->mutable_size()->set_x(x);
-  map.mutable_grid()->mutable_size()->set_y(y);
+  v1::Map map = GridMapSpec(name, x, y, 0.5);
   map.set_shards(1);
   return map;
 }
 
 v1::Map GenericMap(const std::string& name) {
-  v1::Map map;
-  map.set_name(name);
-  map.set_kind(v1::MAP_KIND_GENERIC);
+  v1::Map map = GenericMapSpec(name);
   map.set_shards(1);
   return map;
 }

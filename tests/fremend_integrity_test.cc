@@ -24,6 +24,7 @@
 #include "storage/store.h"
 #include "storage/testing/file_damage.h"
 #include "tests/fremend_fixture.h"
+#include "tests/map_specs.h"
 #include "tests/store_writer.h"
 
 namespace fremen::testing {
@@ -43,8 +44,7 @@ class FremendIntegrityTest : public DaemonTest {
   }
   void CreateGenericMap(const std::string& name) {
     v1::CreateMapRequest request;
-    request.mutable_map()->set_name(name);
-    request.mutable_map()->set_kind(v1::MAP_KIND_GENERIC);
+    *request.mutable_map() = GenericMapSpec(name);
     request.mutable_map()->set_shards(1);
     v1::CreateMapResponse response;
     const grpc::Status status = maps_->CreateMap(CallContext().get(), request, &response);

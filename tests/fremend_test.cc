@@ -11,6 +11,7 @@
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpc/reflection/v1alpha/reflection.grpc.pb.h"
 #include "tests/fremend_fixture.h"
+#include "tests/map_specs.h"
 
 namespace fremen::testing {
 namespace {
@@ -187,8 +188,7 @@ class FremendTokenTest : public DaemonTest {
   }
   grpc::Status Create(const std::string& name, const std::vector<std::pair<std::string, std::string>>& metadata) {
     v1::CreateMapRequest request;
-    request.mutable_map()->set_name(name);
-    request.mutable_map()->set_kind(v1::MAP_KIND_GENERIC);
+    *request.mutable_map() = GenericMapSpec(name);
     v1::CreateMapResponse response;
     return stub_->CreateMap(CallContext(metadata).get(), request, &response);
   }

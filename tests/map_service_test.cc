@@ -9,6 +9,7 @@
 
 #include "fremen/v1/maps.grpc.pb.h"
 #include "tests/fremend_fixture.h"
+#include "tests/map_specs.h"
 
 namespace fremen::testing {
 namespace {
@@ -17,22 +18,9 @@ using ::google::protobuf::util::MessageDifferencer;
 using ::testing::HasSubstr;
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 
-v1::Map GridMap(const std::string& name) {
-  v1::Map map;
-  map.set_name(name);
-  map.set_kind(v1::MAP_KIND_GRID);
-  map.mutable_grid()->set_resolution(0.05);
-  map.mutable_grid()->mutable_size()->set_x(400);
-  map.mutable_grid()->mutable_size()->set_y(300);
-  return map;
-}
+v1::Map GridMap(const std::string& name) { return GridMapSpec(name, 400, 300, 0.05); }
 
-v1::Map GenericMap(const std::string& name) {
-  v1::Map map;
-  map.set_name(name);
-  map.set_kind(v1::MAP_KIND_GENERIC);
-  return map;
-}
+v1::Map GenericMap(const std::string& name) { return GenericMapSpec(name); }
 
 class MapServiceTest : public DaemonTest {
  protected:

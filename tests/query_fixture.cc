@@ -1,6 +1,7 @@
 #include "tests/query_fixture.h"
 
 #include "storage/state_names.h"
+#include "tests/map_specs.h"
 
 namespace fremen::testing {
 
@@ -19,21 +20,14 @@ float CellValue(uint32_t x, uint32_t y, int h) {
 }
 
 v1::Map GridMap(const std::string& name, uint32_t nx, uint32_t ny, bool persistence) {
-  v1::Map map;
-  map.set_name(name);
-  map.set_kind(v1::MAP_KIND_GRID);
-  map.mutable_grid()->set_resolution(0.1);
+  v1::Map map = GridMapSpec(name, nx, ny, 0.1);
   map.mutable_grid()->mutable_origin()->set_x(-1.0);
-  map.mutable_grid()->mutable_size()->set_x(nx);
-  map.mutable_grid()->mutable_size()->set_y(ny);
   map.set_persistence(persistence);
   return map;
 }
 
 v1::Map GenericMap(const std::string& name, double lossless_sampling) {
-  v1::Map map;
-  map.set_name(name);
-  map.set_kind(v1::MAP_KIND_GENERIC);
+  v1::Map map = GenericMapSpec(name);
   map.set_lossless_sampling_seconds(lossless_sampling);
   map.set_lossless_origin(kT0);
   return map;

@@ -201,13 +201,6 @@ SlotSet SlotSet::Decode(ByteReader& reader, std::string_view field) {
   return set;
 }
 
-absl::StatusOr<SlotSet> SlotSet::Decode(std::string_view bytes) {
-  ByteReader reader(bytes, "slot set");
-  SlotSet set = Decode(reader, "set");
-  if (absl::Status s = reader.Finish(); !s.ok()) return s;
-  return set;
-}
-
 uint64_t CountCommon(const SlotSet& a, const SlotSet& b, uint64_t begin, uint64_t end) {
   uint64_t count = 0;
   SlotSet::Cursor ca(a), cb(b);

@@ -20,7 +20,6 @@
 #include <string_view>
 #include <vector>
 
-#include "absl/status/statusor.h"
 #include "storage/model/varint.h"
 
 namespace fremen::model {
@@ -108,8 +107,6 @@ class SlotSet {
   // Reads what EncodeTo wrote; errors (sticky in `reader`) name `field`. Rejects truncated bytes,
   // bad varints and points that are not strictly increasing or not below kMaxPoint.
   static SlotSet Decode(ByteReader& reader, std::string_view field);
-  // The whole of `bytes` must be one encoded set.
-  static absl::StatusOr<SlotSet> Decode(std::string_view bytes);
 
   bool operator==(const SlotSet& other) const { return bytes_ == other.bytes_; }
 

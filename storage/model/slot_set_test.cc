@@ -3,14 +3,25 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "absl/status/statusor.h"
 #include "gtest/gtest.h"
 
 namespace fremen::model {
 namespace {
 
 using Interval = SlotSet::Interval;
+
+// `bytes` decoded as the lossless history decodes its sets (SlotSet::Decode on its ByteReader), the
+// reader then finished, so that bytes left after the set are an error too.
+absl::StatusOr<SlotSet> DecodeWhole(std::string_view bytes) {
+  ByteReader reader(bytes, "slot set");
+  SlotSet set = SlotSet::Decode(reader, "set");
+  if (absl::Status s = reader.Finish(); !s.ok()) return s;
+  return set;
+}
 
 // Membership of slots [0, size) as a plain vector; slots ≥ size take the value of `tail`.
 struct Reference {
@@ -63,7 +74,7 @@ TEST(SlotSet, EmptySet) {
   set.EncodeTo(&bytes);
   EXPECT_EQ(bytes, std::string(1, '\0'));
   EXPECT_EQ(set.encoded_size(), 1u);
-  EXPECT_EQ(*SlotSet::Decode(bytes), set);
+  EXPECT_EQ(*DecodeWhole(bytes), set);
 }
 
 TEST(SlotSet, TogglePointsDelimitIntervalsAndTheLastMayBeOpen) {
@@ -111,7 +122,7 @@ TEST(SlotSet, PointZeroAndFlipsAtTheEdges) {
   EXPECT_EQ(set.byte_size(), 0u);
   set.Flip(SlotSet::kMaxPoint - 2);
   EXPECT_TRUE(set.contains(SlotSet::kMaxPoint - 2));
-  EXPECT_EQ(*SlotSet::Decode([&] {
+  EXPECT_EQ(*DecodeWhole([&] {
     std::string b;
     set.EncodeTo(&b);
     return b;
@@ -163,7 +174,7 @@ TEST(SlotSet, RandomOperationsMatchAReference) {
     std::string bytes;
     set.EncodeTo(&bytes);
     EXPECT_EQ(bytes.size(), set.encoded_size());
-    absl::StatusOr<SlotSet> decoded = SlotSet::Decode(bytes);
+    absl::StatusOr<SlotSet> decoded = DecodeWhole(bytes);
     ASSERT_TRUE(decoded.ok()) << decoded.status();
     EXPECT_EQ(*decoded, set);
     EXPECT_EQ(decoded->toggle_count(), set.toggle_count());
@@ -205,7 +216,7 @@ TEST(SlotSet, DecodeRejectsCorruptedBytes) {
   std::string repeated;
   PutVarint64(&repeated, 2);
   repeated += std::string("\x05\x00", 2);
-  absl::StatusOr<SlotSet> s = SlotSet::Decode(repeated);
+  absl::StatusOr<SlotSet> s = DecodeWhole(repeated);
   EXPECT_EQ(s.status().code(), absl::StatusCode::kDataLoss);
   EXPECT_NE(s.status().message().find("repeats point 5"), std::string::npos) << s.status();
 
@@ -213,11 +224,11 @@ TEST(SlotSet, DecodeRejectsCorruptedBytes) {
   std::string long_length;
   PutVarint64(&long_length, 1000);
   long_length += "\x01";
-  s = SlotSet::Decode(long_length);
+  s = DecodeWhole(long_length);
   EXPECT_NE(s.status().message().find("exceeds"), std::string::npos) << s.status();
 
   // A varint that runs past the set's own length.
-  s = SlotSet::Decode(std::string("\x01\x81\x01", 3));
+  s = DecodeWhole(std::string("\x01\x81\x01", 3));
   EXPECT_EQ(s.status().code(), absl::StatusCode::kDataLoss);
 
   // Points beyond kMaxPoint.
@@ -226,10 +237,10 @@ TEST(SlotSet, DecodeRejectsCorruptedBytes) {
   PutVarint64(&body, SlotSet::kMaxPoint);
   PutVarint64(&huge, body.size());
   huge += body;
-  EXPECT_FALSE(SlotSet::Decode(huge).ok());
+  EXPECT_FALSE(DecodeWhole(huge).ok());
 
   // Trailing bytes.
-  EXPECT_FALSE(SlotSet::Decode(std::string("\x01\x05\x00", 3)).ok());
+  EXPECT_FALSE(DecodeWhole(std::string("\x01\x05\x00", 3)).ok());
 }
 
 TEST(SlotSet, FuzzedEncodingsNeverCrashAndValidOnesAreCanonical) {
@@ -249,7 +260,7 @@ TEST(SlotSet, FuzzedEncodingsNeverCrashAndValidOnesAreCanonical) {
     } else {
       for (int flips = 1 + rng() % 3; flips > 0; --flips) bytes[rng() % bytes.size()] ^= static_cast<char>(1 << (rng() % 8));
     }
-    absl::StatusOr<SlotSet> decoded = SlotSet::Decode(bytes);
+    absl::StatusOr<SlotSet> decoded = DecodeWhole(bytes);
     if (!decoded.ok()) {
       EXPECT_EQ(decoded.status().code(), absl::StatusCode::kDataLoss);
       continue;
