@@ -2,6 +2,8 @@
 # Builds the fuzz targets with clang in BUILD_DIR and runs each for SECONDS, JOBS at a time, then
 # prints a table: executions, executions per second and the inputs that crashed, per target.
 #   fuzz/run.sh BUILD_DIR SECONDS JOBS [TARGET...]     (default: every target of fuzz/CMakeLists.txt)
+# With FUZZ_RUNS=N in the environment a target stops after N executions instead, SECONDS then being
+# only its upper bound: `FUZZ_RUNS=10000000 fuzz/run.sh build-fuzz 3600 2` runs each to 10^7.
 # Each target starts from its seeds (fuzz/corpus/<target>/) and the corpus earlier runs grew
 # (BUILD_DIR/corpus/<target>/, kept between runs). A crashing input is saved as
 # BUILD_DIR/crashes/<target>/crash-<sha1> (or leak-, timeout-, oom-); reproduce it with
@@ -35,7 +37,9 @@ run_one() {
   local log="$results/$target.log" status=0
   # -rss_limit_mb/-malloc_limit_mb: a small input that makes the code under test allocate over
   # 1 GiB is a finding (an unchecked length), not a machine problem. -timeout: 10 s for one input.
-  "$build_dir/bin/fuzz_$target" -max_total_time="$seconds" -print_final_stats=1 -rss_limit_mb=2048 \
+  local runs=()
+  [ -z "${FUZZ_RUNS:-}" ] || runs=(-runs="$FUZZ_RUNS")
+  "$build_dir/bin/fuzz_$target" -max_total_time="$seconds" "${runs[@]}" -print_final_stats=1 -rss_limit_mb=2048 \
     -malloc_limit_mb=1024 -timeout=10 -artifact_prefix="$crashes/" "$corpus" "fuzz/corpus/$target" \
     >"$log" 2>&1 || status=$?
   local execs secs

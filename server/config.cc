@@ -237,6 +237,8 @@ std::vector<ConfigField> MakeConfigFields() {
        "SCHEDULES", SetMapSchedules, MapSchedulesValue},
       DurationField("scrub_interval", "verify every map's files in the background this often (0: never)",
                     &C::scrub_interval, absl::ZeroDuration(), absl::Hours(24 * 366)),
+      DurationField("scrub_map_timeout", "the longest the background scrub of one map may take",
+                    &C::scrub_map_timeout, absl::Seconds(1), absl::Hours(24 * 366)),
       StringField("log_level", "LEVEL", "trace, debug, info, warn, error, critical or off", &C::log_level,
                   [](absl::string_view value) -> absl::Status {
                     for (const char* level : kLogLevels) {

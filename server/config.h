@@ -91,6 +91,9 @@ struct ServerConfig {
   // GetServerStatus. 0 = never (the default: a scrub of a large map reads all of it, and holds
   // back that map's checkpoints while it runs). Range [0, 366d]; e.g. "168h" for weekly.
   absl::Duration scrub_interval = absl::ZeroDuration();
+  // The longest the scrub of one map may take: a shard still being read then is reported "not
+  // verified" in its result and the scrub goes on with the next map. Range [1s, 366d]; default 1h.
+  absl::Duration scrub_map_timeout = absl::Hours(1);
   // trace, debug, info, warn, error, critical or off.
   std::string log_level = "info";
 

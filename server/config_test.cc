@@ -123,13 +123,17 @@ TEST(ConfigTest, PerMapUpdateSchedules) {
               HasSubstr("config: update_map_schedules: map \"lab\" is given twice"));
 }
 
-TEST(ConfigTest, ScrubIntervalIsOffByDefaultAndTakesADuration) {
+TEST(ConfigTest, ScrubIsOffByDefaultAndItsDurationsAreChecked) {
   EXPECT_EQ(ServerConfig().scrub_interval, absl::ZeroDuration());
   ServerConfig config;
   ASSERT_TRUE(ApplyConfigText("scrub_interval = 168h\n", "test.conf", config).ok());
   EXPECT_EQ(config.scrub_interval, absl::Hours(168));
   EXPECT_THAT(ErrorOf("scrub_interval = -1s"), HasSubstr("config: scrub_interval: \"-1s\" is outside [0, "));
   EXPECT_THAT(ErrorOf("scrub_interval = weekly"), HasSubstr("config: scrub_interval: \"weekly\""));
+  EXPECT_EQ(ServerConfig().scrub_map_timeout, absl::Hours(1));
+  ASSERT_TRUE(ApplyConfigText("scrub_map_timeout = 10m\n", "test.conf", config).ok());
+  EXPECT_EQ(config.scrub_map_timeout, absl::Minutes(10));
+  EXPECT_THAT(ErrorOf("scrub_map_timeout = 0s"), HasSubstr("config: scrub_map_timeout: \"0s\" is outside [1s, "));
 }
 
 TEST(ConfigTest, MalformedFilesAreNamedByLine) {

@@ -175,14 +175,15 @@ absl::Status Daemon::PrepareUpdates() {
   scheduler_ = *std::move(scheduler);
   Scrubber::Options scrub;
   scrub.interval = config_.scrub_interval;
+  scrub.map_timeout = config_.scrub_map_timeout;
   scrubber_ = std::make_unique<Scrubber>(
       scrub, RealClock::Get(), [this] { return ListAllMapNames(store_handle_); },
-      [this](const std::string& name) -> absl::StatusOr<storage::VerifyReport> {
+      [this](const std::string& name, absl::Time deadline) -> absl::StatusOr<storage::VerifyReport> {
         auto store = store_handle_.Get();
         if (!store.ok()) return store.status();
         auto map = (*store)->Map(name);  // a failed map is not open, and not scrubbed
         if (!map.ok()) return map.status();
-        return (*map)->Verify();
+        return (*map)->Verify(deadline);
       });
   return absl::OkStatus();
 }

@@ -119,7 +119,7 @@ void Scrubber::Pass() {
 
 void Scrubber::Scrub(const std::string& map) {
   const absl::Time start = clock_.Now();
-  auto report = check_(map);
+  auto report = check_(map, absl::Now() + options_.map_timeout);
   if (!report.ok()) {
     DaemonLog()->debug("scrub of map {} skipped: {}", map, std::string(report.status().message()));
     return;
@@ -135,7 +135,10 @@ void Scrubber::Scrub(const std::string& map) {
     result.problems.push_back(problem);
   }
   for (const storage::ShardVerifyReport& shard : report->shards) result.records += shard.records;
-  if (result.clean) {
+  if (report->deadline_exceeded) {
+    DaemonLog()->error("scrub of map {}: not finished within scrub_map_timeout {}: {}", map,
+                       absl::FormatDuration(options_.map_timeout), storage::FormatProblem(report->problems.back()));
+  } else if (result.clean) {
     DaemonLog()->info("scrub of map {}: clean ({} records)", map, result.records);
   } else {
     DaemonLog()->error("scrub of map {}: {} problems, first {}", map, result.problem_count,

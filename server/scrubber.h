@@ -5,6 +5,11 @@
 // slowing ingest and queries. Its purpose is to find damage that nothing reads (a model no query has
 // asked for since the disk flipped its bits) before a restart or a backup depends on it.
 //
+// One map's check is bounded by `map_timeout` (config scrub_map_timeout): a shard still being read
+// then is reported "not verified" (its reading child is killed) and the pass goes on with the next
+// map, so that a map whose files block the reader (a hung disk) neither stalls the scrub of the
+// others nor holds back Stop — and so a daemon's shutdown — for longer than that.
+//
 // Nothing is repaired. Each map's latest result is kept (Results(), GetServerStatus map_scrubs) and
 // logged: a clean pass at info, problems at error with the first one named. Failed maps are not
 // scrubbed (they are not open; GetServerStatus lists them as failed already).
@@ -48,11 +53,13 @@ class Scrubber {
     // Lower the scrub thread's CPU and I/O priority (nice 19, idle I/O class); its forked children
     // inherit them. Default true; tests of the schedule leave the test process alone.
     bool low_priority = true;
+    // The longest one map's check may take (real time, as the reading child is killed by it).
+    absl::Duration map_timeout = absl::Hours(1);
   };
   // The maps to scrub now; an error skips the pass (and is logged).
   using MapLister = std::function<absl::StatusOr<std::vector<std::string>>()>;
-  // Verifies one map; an error (a map deleted meanwhile, a failed map) skips it.
-  using Check = std::function<absl::StatusOr<storage::VerifyReport>(const std::string& map)>;
+  // Verifies one map by `deadline`; an error (a map deleted meanwhile, a failed map) skips it.
+  using Check = std::function<absl::StatusOr<storage::VerifyReport>(const std::string& map, absl::Time deadline)>;
 
   // `clock` must outlive the scrubber. The first pass is due one interval after Start.
   Scrubber(Options options, const Clock& clock, MapLister list_maps, Check check);
@@ -62,7 +69,8 @@ class Scrubber {
 
   // Starts the thread; does nothing when the interval is 0.
   void Start() ABSL_LOCKS_EXCLUDED(mutex_);
-  // Stops and joins the thread; a pass under way stops after the map it is verifying. Idempotent.
+  // Stops and joins the thread; a pass under way stops after the map it is verifying (so within
+  // map_timeout). Idempotent.
   void Stop() ABSL_LOCKS_EXCLUDED(mutex_);
 
   bool enabled() const { return options_.interval > absl::ZeroDuration(); }

@@ -1,7 +1,8 @@
 // The background scrub's thread driven by a fake clock (no sleeps): a pass is due one interval
 // after Start and one interval after the end of the previous pass; each map's latest result is
 // kept (problems capped, records summed), maps no longer listed are dropped, a map whose check
-// fails is skipped, and an interval of 0 starts nothing.
+// fails is skipped, each map's check is given scrub_map_timeout and one that runs out of it is
+// reported unclean while the pass goes on, and an interval of 0 starts nothing.
 #include "server/scrubber.h"
 
 #include <gmock/gmock.h>
@@ -9,6 +10,7 @@
 
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "server/fake_clock.h"
@@ -53,7 +55,7 @@ struct FakeStore {
     };
   }
   Scrubber::Check Checker() {
-    return [this](const std::string& map) -> absl::StatusOr<storage::VerifyReport> {
+    return [this](const std::string& map, absl::Time) -> absl::StatusOr<storage::VerifyReport> {
       std::function<void()> during;
       {
         std::lock_guard lock(mutex);
@@ -179,7 +181,7 @@ TEST(ScrubberTest, AListingErrorSkipsThePassAndTheNextOneComes) {
         if (fail) return absl::UnavailableError("recovering");
         return std::vector<std::string>{"a"};
       },
-      [&](const std::string& map) -> absl::StatusOr<storage::VerifyReport> {
+      [&](const std::string& map, absl::Time) -> absl::StatusOr<storage::VerifyReport> {
         std::lock_guard lock(mutex);
         checked.push_back(map);
         return Report(map, 0, 1);
@@ -198,6 +200,57 @@ TEST(ScrubberTest, AListingErrorSkipsThePassAndTheNextOneComes) {
   ASSERT_TRUE(scrubber.AwaitPasses(2, kWait));
   std::lock_guard lock(mutex);
   EXPECT_THAT(checked, ElementsAre("a"));
+}
+
+}  // namespace
+}  // namespace fremen::server
+
+namespace fremen::server {
+namespace {
+
+// Each check is given a deadline of map_timeout from its start (real time: the verifier's reading
+// child is killed by it); a map whose check ran out of it is kept as not clean, with the verifier's
+// "not verified" problem, and the pass goes on with the next map.
+TEST(ScrubberTest, EachMapsCheckIsBoundedByTheMapTimeoutAndAnOverrunIsReported) {
+  FakeClock clock(kStart);
+  constexpr absl::Duration kMapTimeout = absl::Minutes(7);
+  std::mutex mutex;
+  std::vector<std::pair<std::string, absl::Duration>> deadlines;  // map, deadline - call time
+  Scrubber::Options options = Every(kInterval);
+  options.map_timeout = kMapTimeout;
+  Scrubber scrubber(
+      options, clock, []() -> absl::StatusOr<std::vector<std::string>> { return std::vector<std::string>{"hung", "b"}; },
+      [&](const std::string& map, absl::Time deadline) -> absl::StatusOr<storage::VerifyReport> {
+        const absl::Time called = absl::Now();
+        std::lock_guard lock(mutex);
+        deadlines.emplace_back(map, deadline - called);
+        storage::VerifyReport report = Report(map, 0, 3);
+        if (map == "hung") {
+          report.deadline_exceeded = true;
+          report.problems.push_back({"shard-0/data.mdb", "", "not verified: the reading process had not finished"});
+        }
+        return report;
+      });
+  scrubber.Start();
+  ASSERT_TRUE(clock.AwaitWaiters(1));
+  clock.Advance(kInterval);
+  ASSERT_TRUE(scrubber.AwaitPasses(1, kWait));
+  {
+    std::lock_guard lock(mutex);
+    ASSERT_EQ(deadlines.size(), 2u);
+    for (const auto& [map, left] : deadlines) {
+      EXPECT_LE(left, kMapTimeout) << map;
+      EXPECT_GT(left, kMapTimeout - absl::Seconds(30)) << map;  // set at the call, not at Start
+    }
+  }
+  const std::vector<Scrubber::Result> results = scrubber.Results();
+  ASSERT_EQ(results.size(), 2u);
+  EXPECT_EQ(results[0].map, "b");
+  EXPECT_TRUE(results[0].clean);
+  EXPECT_EQ(results[1].map, "hung");
+  EXPECT_FALSE(results[1].clean);
+  ASSERT_EQ(results[1].problems.size(), 1u);
+  EXPECT_EQ(results[1].problems[0].what, "not verified: the reading process had not finished");
 }
 
 }  // namespace
