@@ -8,7 +8,7 @@
 
 #include "fremen/v1/maps.pb.h"
 #include "fuzz/fuzz_util.h"
-#include "server/map_convert.h"
+#include "server/convert/map_convert.h"
 #include "storage/map_info.h"
 
 namespace {

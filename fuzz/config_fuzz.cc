@@ -1,4 +1,4 @@
-// fremend's config file (server/config.h ApplyConfigText), then the cross-setting checks of
+// fremend's config file (server/daemon/config.h ApplyConfigText), then the cross-setting checks of
 // FinishConfig (with the settings that name files cleared: the fuzzer must not read files). A
 // config that applies spells every setting so that the spelling applies to the same spelling.
 // Input: the file's text.
@@ -8,7 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "fuzz/fuzz_util.h"
-#include "server/config.h"
+#include "server/daemon/config.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace fremen;

@@ -1,4 +1,4 @@
-// IngestRequest → ObservationBatch (server/ingest_convert.h), then what the store does with an
+// IngestRequest → ObservationBatch (server/convert/ingest_convert.h), then what the store does with an
 // accepted batch before it is logged: ValidateBatch, Classify and the log payload's round trip.
 // Input: a byte choosing the map (fuzz_util.h FuzzMap), then a serialized fremen.v1.IngestRequest.
 #include <cstddef>
@@ -7,7 +7,7 @@
 
 #include "fremen/v1/ingest.pb.h"
 #include "fuzz/fuzz_util.h"
-#include "server/ingest_convert.h"
+#include "server/convert/ingest_convert.h"
 #include "storage/batch.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

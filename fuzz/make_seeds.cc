@@ -20,10 +20,10 @@
 #include "storage/batch.h"
 #include "storage/dedup_table.h"
 #include "storage/map_info.h"
-#include "storage/model/lossless_history.h"
+#include "storage/model/lossless/lossless_history.h"
 #include "storage/model/record_codec.h"
 #include "storage/model/state_model.h"
-#include "storage/model/wide_bodies.h"
+#include "storage/model/kernels/wide_bodies.h"
 #include "storage/static_bricks.h"
 #include "storage/update_record.h"
 

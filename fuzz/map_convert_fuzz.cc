@@ -1,4 +1,4 @@
-// fremen.v1.Map → storage::MapInfo (server/map_convert.h), as CreateMap takes it, then what a map
+// fremen.v1.Map → storage::MapInfo (server/convert/map_convert.h), as CreateMap takes it, then what a map
 // the daemon accepted must keep: its model settings exist, and the map survives the catalog's
 // encoding and the way back to the proto unchanged. Input: a serialized fremen.v1.Map.
 #include <cstddef>
@@ -6,7 +6,7 @@
 
 #include "fremen/v1/maps.pb.h"
 #include "fuzz/fuzz_util.h"
-#include "server/map_convert.h"
+#include "server/convert/map_convert.h"
 #include "storage/map_info.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

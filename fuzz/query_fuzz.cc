@@ -1,7 +1,7 @@
 // The QueryService's conversions, without a store: a request's checks and state references
-// (server/query_args.h, server/state_refs.h), a PredictRegion request's box and chunk plan
-// (server/region_plan.h), and a state's stored model as GetStateModel shows it
-// (server/query_convert.h, from records decoded as a shard decodes them).
+// (server/convert/query_args.h, server/convert/state_refs.h), a PredictRegion request's box and chunk plan
+// (server/services/region_plan.h), and a state's stored model as GetStateModel shows it
+// (server/convert/query_convert.h, from records decoded as a shard decodes them).
 //
 // Input: a byte choosing the case and the map, then
 //   0: a serialized PredictRequest (Predict's checks, in the service's order);
@@ -16,11 +16,11 @@
 
 #include "fremen/v1/query.pb.h"
 #include "fuzz/fuzz_util.h"
-#include "server/query_args.h"
-#include "server/query_convert.h"
-#include "server/region_plan.h"
-#include "server/state_refs.h"
-#include "storage/model/lossless_history.h"
+#include "server/convert/query_args.h"
+#include "server/convert/query_convert.h"
+#include "server/services/region_plan.h"
+#include "server/convert/state_refs.h"
+#include "storage/model/lossless/lossless_history.h"
 #include "storage/model/record_codec.h"
 
 namespace {

@@ -11,10 +11,10 @@
 
 #include "fuzz/fuzz_util.h"
 #include "storage/map_info.h"
-#include "storage/model/lossless_history.h"
+#include "storage/model/lossless/lossless_history.h"
 #include "storage/model/record_codec.h"
 #include "storage/model/state_model.h"
-#include "storage/model/wide_bodies.h"
+#include "storage/model/kernels/wide_bodies.h"
 #include "storage/static_bricks.h"
 
 namespace {

@@ -15,28 +15,13 @@
 #include "absl/status/statusor.h"
 #include "storage/lmdb/lmdb_env.h"
 #include "storage/map_info.h"
+#include "storage/map_page.h"
 
 namespace fremen::storage {
-
-// A catalog record that did not verify or decode.
-struct DamagedCatalogEntry {
-  std::string key;      // the stored name (itself possibly damaged)
-  absl::Status status;  // DataLoss naming the file and key
-};
-
-struct MapPage {
-  std::vector<MapInfo> maps;
-  // Pass to the next List call; empty on the last page.
-  std::string next_page_token;
-  // Damaged records met while listing this page, in key order; not in `maps`.
-  std::vector<DamagedCatalogEntry> damaged;
-};
 
 // Where the files of the map with `id` live in a data directory: <data dir>/maps/<id> (store.h).
 std::string MapDirIn(const std::string& data_dir, uint64_t id);
 
-inline constexpr size_t kMaxPageSize = 1000;
-inline constexpr size_t kDefaultPageSize = 100;
 
 class Catalog {
  public:

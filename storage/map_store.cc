@@ -1,4 +1,4 @@
-#include "storage/map_store.h"
+#include "storage/map_store_impl.h"
 
 #include <sys/stat.h>
 
@@ -42,18 +42,25 @@ bool IsQueueFull(const absl::Status& status) {
   return status.code() == absl::StatusCode::kResourceExhausted && status.GetPayload(kQueueFullPayload).has_value();
 }
 
-MapStore::MapStore(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings)
+MapStoreImpl::MapStoreImpl(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings)
     : info_(std::move(info)), dir_(std::move(dir)), options_(options), settings_(std::move(settings)) {}
 
 absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const MapInfo& info, const std::string& dir,
                                                          const StoreOptions& options) {
+  auto store = MapStoreImpl::Open(info, dir, options);
+  if (!store.ok()) return store.status();
+  return std::unique_ptr<MapStore>(*std::move(store));
+}
+
+absl::StatusOr<std::unique_ptr<MapStoreImpl>> MapStoreImpl::Open(const MapInfo& info, const std::string& dir,
+                                                                 const StoreOptions& options) {
   if (absl::Status valid = ValidateMapInfo(info); !valid.ok()) return valid;
   if (info.shards == 0) return absl::InvalidArgumentError("shards must be set before a map is opened");
   auto settings = ModelSettingsOf(info);
   if (!settings.ok()) return settings.status();
   if (absl::Status s = MakeDir(dir); !s.ok()) return s;
-  auto store = std::unique_ptr<MapStore>(
-      new MapStore(info, dir, options, std::make_unique<model::ModelSettings>(*std::move(settings))));
+  auto store = std::unique_ptr<MapStoreImpl>(
+      new MapStoreImpl(info, dir, options, std::make_unique<model::ModelSettings>(*std::move(settings))));
   LmdbOptions lmdb;
   lmdb.initial_map_size = options.initial_map_size;
   for (uint32_t i = 0; i < info.shards; ++i) {
@@ -75,9 +82,9 @@ absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const MapInfo& info, co
   return store;
 }
 
-MapStore::~MapStore() { (void)Close(); }
+MapStoreImpl::~MapStoreImpl() { (void)Close(); }
 
-void MapStore::Warn(const std::string& message) const {
+void MapStoreImpl::Warn(const std::string& message) const {
   if (options_.log_warning) {
     options_.log_warning(message);
   } else {
@@ -85,7 +92,7 @@ void MapStore::Warn(const std::string& message) const {
   }
 }
 
-absl::Status MapStore::Recover() {
+absl::Status MapStoreImpl::Recover() {
   // Replay starts after the oldest checkpoint; new records start above the newest (the LSN floor).
   uint64_t from = UINT64_MAX, newest = 0;
   for (const auto& shard : shards_) {
@@ -151,7 +158,7 @@ absl::Status MapStore::Recover() {
   return absl::OkStatus();
 }
 
-MapStore::Pending MapStore::Prepare(ObservationBatch batch, AckCallback done) const {
+MapStoreImpl::Pending MapStoreImpl::Prepare(ObservationBatch batch, AckCallback done) const {
   Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}, {}};
   pending.ack = Classify(info_, pending.batch, pending.accept);
   pending.record.push_back(kBatchRecord);
@@ -161,7 +168,7 @@ MapStore::Pending MapStore::Prepare(ObservationBatch batch, AckCallback done) co
   return pending;
 }
 
-void MapStore::SplitByShard(Pending& pending) const {
+void MapStoreImpl::SplitByShard(Pending& pending) const {
   std::vector<std::vector<uint64_t>>& keys = pending.keys;
   std::vector<std::vector<float>>& values = pending.values;
   keys.assign(info_.shards, {});
@@ -191,7 +198,7 @@ void MapStore::SplitByShard(Pending& pending) const {
   }
 }
 
-absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
+absl::Status MapStoreImpl::Submit(ObservationBatch batch, AckCallback done) {
   if (absl::Status valid = ValidateBatch(info_, batch); !valid.ok()) return valid;
   if (info_.lossless_sampling_period > 0 && batch.time < info_.lossless_origin) {
     return absl::InvalidArgumentError(absl::StrCat("time must not be before the map's lossless origin ",
@@ -226,7 +233,7 @@ absl::Status MapStore::Submit(ObservationBatch batch, AckCallback done) {
   return absl::OkStatus();
 }
 
-void MapStore::OnRoom(uint64_t observations, std::function<void()> f) {
+void MapStoreImpl::OnRoom(uint64_t observations, std::function<void()> f) {
   {
     base::MutexLock lock(&queue_mutex_);
     if (!FitsLocked(observations) && !closing_ && write_error_.ok()) {
@@ -237,7 +244,7 @@ void MapStore::OnRoom(uint64_t observations, std::function<void()> f) {
   f();
 }
 
-absl::StatusOr<BatchAck> MapStore::Write(ObservationBatch batch) {
+absl::StatusOr<BatchAck> MapStoreImpl::Write(ObservationBatch batch) {
   std::promise<absl::StatusOr<BatchAck>> promise;
   auto future = promise.get_future();
   if (absl::Status s = Submit(std::move(batch), [&](absl::StatusOr<BatchAck> ack) { promise.set_value(std::move(ack)); });
@@ -249,12 +256,12 @@ absl::StatusOr<BatchAck> MapStore::Write(ObservationBatch batch) {
   return ack;
 }
 
-uint64_t MapStore::LastSequence(uint64_t writer) const {
+uint64_t MapStoreImpl::LastSequence(uint64_t writer) const {
   base::MutexLock lock(&dedup_mutex_);
   return dedup_.LastSequence(writer);
 }
 
-absl::StatusOr<uint64_t> MapStore::RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress) {
+absl::StatusOr<uint64_t> MapStoreImpl::RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress) {
   std::promise<absl::StatusOr<uint64_t>> promise;
   auto future = promise.get_future();
   {
@@ -267,20 +274,20 @@ absl::StatusOr<uint64_t> MapStore::RunControl(Control::Kind kind, std::function<
   return future.get();
 }
 
-absl::Status MapStore::Checkpoint() { return RunControl(Control::Kind::kCheckpoint).status(); }
+absl::Status MapStoreImpl::Checkpoint() { return RunControl(Control::Kind::kCheckpoint).status(); }
 
-absl::StatusOr<uint64_t> MapStore::PublishModels(std::function<void(uint64_t, uint64_t)> progress) {
+absl::StatusOr<uint64_t> MapStoreImpl::PublishModels(std::function<void(uint64_t, uint64_t)> progress) {
   return RunControl(Control::Kind::kPublish, std::move(progress));
 }
 
-absl::Status MapStore::RecordUpdate(const UpdateRecord& record) {
+absl::Status MapStoreImpl::RecordUpdate(const UpdateRecord& record) {
   base::MutexLock lock(&last_update_mutex_);
   if (absl::Status s = WriteUpdateRecord(options_.env, LastUpdatePath(dir_), record); !s.ok()) return s;
   last_update_ = record;
   return absl::OkStatus();
 }
 
-absl::Status MapStore::Close() {
+absl::Status MapStoreImpl::Close() {
   {
     base::MutexLock lock(&queue_mutex_);
     closing_ = true;
@@ -293,12 +300,12 @@ absl::Status MapStore::Close() {
   return write_error_;
 }
 
-absl::Status MapStore::WriteError() const {
+absl::Status MapStoreImpl::WriteError() const {
   base::MutexLock lock(&queue_mutex_);
   return write_error_;
 }
 
-void MapStore::Latch(const absl::Status& status) {
+void MapStoreImpl::Latch(const absl::Status& status) {
   std::vector<std::function<void()>> room;
   {
     base::MutexLock lock(&queue_mutex_);
@@ -319,7 +326,7 @@ void MapStore::Latch(const absl::Status& status) {
   for (auto& f : room) f();
 }
 
-void MapStore::CommitLoop() {
+void MapStoreImpl::CommitLoop() {
   for (;;) {
     Stage stage;
     std::vector<std::function<void()>> room;
@@ -381,7 +388,7 @@ void MapStore::CommitLoop() {
   }
 }
 
-void MapStore::LogGroup(std::vector<Pending>& group) {
+void MapStoreImpl::LogGroup(std::vector<Pending>& group) {
   base::MutexLock lock(&dedup_mutex_);
   for (Pending& p : group) {
     const absl::StatusOr<bool> seen = dedup_.Seen(p.batch.writer_id, p.batch.sequence, p.fingerprint);
@@ -400,7 +407,7 @@ void MapStore::LogGroup(std::vector<Pending>& group) {
   }
 }
 
-void MapStore::ApplyLoop() {
+void MapStoreImpl::ApplyLoop() {
   for (;;) {
     Stage stage;
     {
@@ -447,7 +454,7 @@ void MapStore::ApplyLoop() {
   }
 }
 
-void MapStore::ApplyGroup(std::vector<Pending>& group) {
+void MapStoreImpl::ApplyGroup(std::vector<Pending>& group) {
   // Every shard folds in its part of every batch, in batch order.
   std::vector<const Pending*> fresh;
   for (const Pending& p : group) {
@@ -472,7 +479,7 @@ void MapStore::ApplyGroup(std::vector<Pending>& group) {
   for (Pending& p : group) p.done(p.ack);
 }
 
-void MapStore::IndexLabels(std::span<const StateLabel> labels) {
+void MapStoreImpl::IndexLabels(std::span<const StateLabel> labels) {
   if (labels.empty()) return;
   base::MutexLock lock(&groups_mutex_);
   for (const StateLabel& l : labels) {
@@ -482,7 +489,7 @@ void MapStore::IndexLabels(std::span<const StateLabel> labels) {
   }
 }
 
-void MapStore::StartPublication(Control control) {
+void MapStoreImpl::StartPublication(Control control) {
   // The committer has logged and synced the publication's record already.
   FinishPublication();
   std::vector<uint64_t> marked(shards_.size());
@@ -495,7 +502,7 @@ void MapStore::StartPublication(Control control) {
   if (publication_total_ == 0) FinishPublication();
 }
 
-void MapStore::ContinuePublication() {
+void MapStoreImpl::ContinuePublication() {
   // A slice bounds how long a batch that arrives meanwhile waits to be applied and acknowledged.
   constexpr auto kSlice = std::chrono::milliseconds(20);
   std::vector<uint8_t> finished(shards_.size());
@@ -509,11 +516,11 @@ void MapStore::ContinuePublication() {
   }
 }
 
-void MapStore::FinishPublication() {
+void MapStoreImpl::FinishPublication() {
   while (publication_.has_value()) ContinuePublication();
 }
 
-void MapStore::StartCheckpoint(uint64_t lsn, std::vector<Control> waiting) {
+void MapStoreImpl::StartCheckpoint(uint64_t lsn, std::vector<Control> waiting) {
   WaitCheckpointWrite();
   // After a write error nothing more is written (LevelDB's bg_error_): the disk misbehaves, and
   // every applied batch is in the log already, which the next recovery replays.
@@ -530,16 +537,16 @@ void MapStore::StartCheckpoint(uint64_t lsn, std::vector<Control> waiting) {
   });
 }
 
-bool MapStore::CheckpointWriting() const {
+bool MapStoreImpl::CheckpointWriting() const {
   return checkpoint_write_.valid() &&
          checkpoint_write_.wait_for(std::chrono::seconds(0)) != std::future_status::ready;
 }
 
-void MapStore::WaitCheckpointWrite() {
+void MapStoreImpl::WaitCheckpointWrite() {
   if (checkpoint_write_.valid()) checkpoint_write_.get();
 }
 
-absl::Status MapStore::WriteCheckpoint(uint64_t lsn, std::vector<Shard::CheckpointImage>& images) {
+absl::Status MapStoreImpl::WriteCheckpoint(uint64_t lsn, std::vector<Shard::CheckpointImage>& images) {
   // No backup copies the shards while they change, so that every copy is at one log position.
   base::MutexLock backup(&backup_mutex_);
   if (absl::Status error = WriteError(); !error.ok()) return error;  // latched meanwhile: see StartCheckpoint
@@ -560,7 +567,7 @@ absl::Status MapStore::WriteCheckpoint(uint64_t lsn, std::vector<Shard::Checkpoi
   return status;
 }
 
-std::vector<float> MapStore::Predict(std::span<const uint64_t> keys, std::span<const double> times,
+std::vector<float> MapStoreImpl::Predict(std::span<const uint64_t> keys, std::span<const double> times,
                                      const PredictOptions& options) const {
   std::vector<float> out;
   out.reserve(keys.size() * times.size());
@@ -571,7 +578,7 @@ std::vector<float> MapStore::Predict(std::span<const uint64_t> keys, std::span<c
   return out;
 }
 
-absl::Status MapStore::PredictBox(const CellBox& box, double t, const PredictOptions& options,
+absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
                                   std::vector<float>& out) const {
   if (info_.kind != MapKind::kGrid) {
     return absl::FailedPreconditionError(absl::StrCat("map ", info_.name, " is not a grid: it has no boxes"));
@@ -591,15 +598,15 @@ absl::Status MapStore::PredictBox(const CellBox& box, double t, const PredictOpt
   return absl::OkStatus();
 }
 
-std::optional<StateSnapshot> MapStore::Snapshot(uint64_t key) const { return ShardFor(key).Snapshot(key); }
+std::optional<StateSnapshot> MapStoreImpl::Snapshot(uint64_t key) const { return ShardFor(key).Snapshot(key); }
 
-std::vector<uint8_t> MapStore::Observed(std::span<const uint64_t> keys) const {
+std::vector<uint8_t> MapStoreImpl::Observed(std::span<const uint64_t> keys) const {
   std::vector<uint8_t> out(keys.size());
   for (size_t i = 0; i < keys.size(); ++i) out[i] = ShardFor(keys[i]).Observed(keys[i]);
   return out;
 }
 
-absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStore::TopN(const std::string& group, double t, size_t n,
+absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStoreImpl::TopN(const std::string& group, double t, size_t n,
                                                                       const PredictOptions& options) const {
   std::vector<uint64_t> members;
   {
@@ -622,7 +629,7 @@ absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStore::TopN(const std
   return ranked;
 }
 
-MapStats MapStore::Stats() const {
+MapStats MapStoreImpl::Stats() const {
   MapStats stats;
   stats.totals.order_histogram.assign(settings_->max_order + 1, 0);
   for (const auto& shard : shards_) stats.totals += shard->Stats();
@@ -651,7 +658,7 @@ MapStats MapStore::Stats() const {
   return stats;
 }
 
-absl::StatusOr<uint64_t> MapStore::Backup(const std::string& dir) {
+absl::StatusOr<uint64_t> MapStoreImpl::Backup(const std::string& dir) {
   if (absl::Status s = MakeDir(dir); !s.ok()) return s;
   if (absl::Status s = Checkpoint(); !s.ok()) return s;
   // No checkpoint can run while this is held, so every shard's copy is at the same log position.
@@ -668,7 +675,7 @@ absl::StatusOr<uint64_t> MapStore::Backup(const std::string& dir) {
   return bytes;
 }
 
-VerifyReport MapStore::Verify(absl::Time deadline) {
+VerifyReport MapStoreImpl::Verify(absl::Time deadline) {
   base::MutexLock backup(&backup_mutex_);
   VerifyOptions options;
   options.isolate = true;

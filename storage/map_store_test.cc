@@ -7,9 +7,10 @@
 #include <thread>
 
 #include "storage/env/fault_injection_env.h"
-#include "storage/model/compact_models.h"
+#include "storage/lmdb/lmdb_env.h"
+#include "storage/model/kernels/compact_models.h"
 #include "storage/model/phasor.h"
-#include "storage/model/region_predict.h"
+#include "storage/model/kernels/region_predict.h"
 #include "storage/testing/open_map_store.h"
 #include "storage/testing/scans.h"
 #include "testing/temp_dir.h"

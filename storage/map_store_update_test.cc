@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "storage/map_store.h"
-#include "storage/model/lossless_history.h"
+#include "storage/model/lossless/lossless_history.h"
 #include "storage/model/record_codec.h"
 #include "storage/testing/open_map_store.h"
 #include "storage/testing/scans.h"

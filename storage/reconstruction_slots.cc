@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
-#include "storage/model/lossless_history.h"
+#include "storage/model/lossless/lossless_history.h"
 
 namespace fremen::storage {
 

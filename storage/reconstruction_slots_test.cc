@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "storage/model/lossless_history.h"
+#include "storage/model/lossless/lossless_history.h"
 
 namespace fremen::storage {
 namespace {

@@ -13,6 +13,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "storage/batch.h"
+#include "storage/catalog.h"
 #include "storage/cell_key.h"
 #include "storage/dedup_table.h"
 #include "storage/isolated_child.h"

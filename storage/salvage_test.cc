@@ -13,6 +13,7 @@
 
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
+#include "storage/catalog.h"
 #include "storage/cell_key.h"
 #include "storage/env/fault_injection_env.h"
 #include "storage/lmdb/lmdb_env.h"

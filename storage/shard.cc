@@ -5,10 +5,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "storage/cell_key.h"
-#include "storage/model/publication.h"
+#include "storage/model/kernels/publication.h"
 #include "storage/model/record_codec.h"
-#include "storage/model/region_predict.h"
-#include "storage/model/scan_update.h"
+#include "storage/model/kernels/region_predict.h"
+#include "storage/model/kernels/scan_update.h"
 #include "storage/shard_records.h"
 #include "storage/static_bricks.h"
 

@@ -45,16 +45,17 @@
 #include "storage/dedup_table.h"
 #include "storage/lmdb/lmdb_env.h"
 #include "storage/map_info.h"
-#include "storage/model/compact_models.h"
-#include "storage/model/lossless_history.h"
-#include "storage/model/order_error_table.h"
+#include "storage/model/kernels/compact_models.h"
+#include "storage/model/lossless/lossless_history.h"
+#include "storage/model/kernels/order_error_table.h"
 #include "storage/model/persistence.h"
-#include "storage/model/publication.h"
-#include "storage/model/record_arena.h"
-#include "storage/model/scan_update.h"
+#include "storage/model/kernels/publication.h"
+#include "storage/model/kernels/record_arena.h"
+#include "storage/model/kernels/scan_update.h"
 #include "storage/model/state_model.h"
 #include "storage/model/static_state.h"
-#include "storage/model/wide_bodies.h"
+#include "storage/model/kernels/wide_bodies.h"
+#include "storage/queries.h"
 #include "storage/shard_stats.h"
 
 namespace fremen::storage {
@@ -65,30 +66,6 @@ struct ScanContext {
   model::PhasorTable table;
   model::ScanPhasors<float> phasors;
 };
-
-struct PredictOptions {
-  bool persistence = false;  // blend in the last observation (the persistence model)
-  int order = -1;            // -1: each state's selected order
-};
-
-// A box of grid cells, [lo, hi) per axis.
-struct CellBox {
-  std::array<uint32_t, 3> lo = {0, 0, 0};
-  std::array<uint32_t, 3> hi = {0, 0, 0};
-  uint64_t cell_count() const { return uint64_t{hi[0] - lo[0]} * (hi[1] - lo[1]) * (hi[2] - lo[2]); }
-};
-
-// A copy of one state's complete model, for the full-model view and for tests.
-struct StateSnapshot {
-  bool is_static = true;
-  model::StaticState static_state;               // when is_static
-  std::optional<model::CompactStateModel> model;  // when dynamic
-  std::optional<model::LosslessHistory> lossless;
-  std::string name, group;
-};
-
-// The value an unobserved state predicts: no information either way.
-inline constexpr float kUnobservedProbability = 0.5f;
 
 class Shard {
  public:

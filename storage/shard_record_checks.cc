@@ -1,9 +1,9 @@
 #include "storage/shard_record_checks.h"
 
 #include "absl/strings/str_cat.h"
-#include "storage/model/lossless_history.h"
+#include "storage/model/lossless/lossless_history.h"
 #include "storage/model/record_codec.h"
-#include "storage/model/wide_bodies.h"
+#include "storage/model/kernels/wide_bodies.h"
 #include "storage/shard_records.h"
 
 namespace fremen::storage {

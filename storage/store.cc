@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "storage/catalog.h"
 #include "storage/data_dir_format.h"
 #include "storage/lmdb/lmdb_probe.h"
 #include "storage/verify.h"
@@ -101,6 +102,9 @@ std::vector<FailedMap> Store::FailedMaps() const {
 }
 
 std::vector<std::string> Store::UnknownDirectories() const { return unknown_dirs_; }
+
+Store::Store(std::string data_dir, StoreOptions options, std::unique_ptr<Catalog> catalog)
+    : data_dir_(std::move(data_dir)), options_(options), catalog_(std::move(catalog)) {}
 
 Store::~Store() { (void)Close(); }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "absl/strings/escaping.h"
+#include "storage/catalog.h"
 #include "storage/lmdb/lmdb_env.h"
 #include "storage/lmdb/record_checksum.h"
 #include "storage/model/record_codec.h"

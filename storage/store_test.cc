@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "storage/catalog.h"
 #include "storage/testing/file_damage.h"
 #include "storage/testing/scans.h"
 #include "testing/temp_dir.h"

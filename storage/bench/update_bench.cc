@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "storage/map_store.h"
-#include "storage/model/lossless_history.h"
+#include "storage/model/lossless/lossless_history.h"
 #include "testing/temp_dir.h"
 
 namespace fremen::storage {

@@ -22,13 +22,13 @@
 #include <string>
 #include <vector>
 
-#include "storage/model/compact_models.h"
-#include "storage/model/order_error_table.h"
+#include "storage/model/kernels/compact_models.h"
+#include "storage/model/kernels/order_error_table.h"
 #include "storage/model/persistence.h"
-#include "storage/model/publication.h"
-#include "storage/model/record_arena.h"
-#include "storage/model/region_predict.h"
-#include "storage/model/scan_update.h"
+#include "storage/model/kernels/publication.h"
+#include "storage/model/kernels/record_arena.h"
+#include "storage/model/kernels/region_predict.h"
+#include "storage/model/kernels/scan_update.h"
 #include "storage/model/static_state.h"
 
 namespace fremen::model {

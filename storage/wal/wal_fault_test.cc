@@ -27,6 +27,7 @@
 #include "storage/env/fault_injection_env.h"
 #include "storage/map_store.h"
 #include "storage/testing/scans.h"
+#include "storage/wal/wal.h"
 #include "testing/temp_dir.h"
 
 namespace fremen::storage {

@@ -1,0 +1,415 @@
+#include "server/services/admin_service.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <system_error>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "server/services/backup_path.h"
+#include "server/rpc/logging.h"
+#include "server/convert/map_convert.h"
+#include "server/jobs/map_list.h"
+#include "server/rpc/map_name.h"
+#include "server/convert/operation_convert.h"
+#include "server/convert/query_convert.h"
+#include "storage/map_page.h"
+#include "storage/verify.h"
+
+namespace fremen::server {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr MethodSpec kRunUpdate{"RunUpdate", Access::kWrite, /*blocking=*/false};
+constexpr MethodSpec kGetOperation{"GetOperation", Access::kRead, /*blocking=*/false};
+constexpr MethodSpec kListOperations{"ListOperations", Access::kRead, /*blocking=*/false};
+constexpr MethodSpec kCancelOperation{"CancelOperation", Access::kWrite, /*blocking=*/false};
+constexpr MethodSpec kBackupMap{"BackupMap", Access::kWrite, /*blocking=*/true};
+constexpr MethodSpec kRestoreMap{"RestoreMap", Access::kWrite, /*blocking=*/true};
+constexpr MethodSpec kGetServerStatus{"GetServerStatus", Access::kRead, /*blocking=*/true};
+constexpr MethodSpec kCheckMap{"CheckMap", Access::kRead, /*blocking=*/true};
+constexpr MethodSpec kSalvageMap{"SalvageMap", Access::kWrite, /*blocking=*/true};
+
+constexpr char kOperationPrefix[] = "operations/";
+
+// The map a call names in its field or header, or "" when it names none (where that is allowed:
+// operations are found by name, and a restore may keep the backed-up name).
+absl::StatusOr<std::string> OptionalMapName(const grpc::ServerContextBase& context, const std::string& request_map,
+                                            absl::string_view field) {
+  const auto& metadata = context.client_metadata();
+  const auto header = metadata.find(kMapHeader);
+  if (request_map.empty() && (header == metadata.end() || header->second.empty())) return std::string();
+  return ResolveMapName(context, request_map, field);
+}
+
+// Storage names the new map "name"; the restore request calls it "map", the salvage request "new_map".
+absl::Status RenameNameField(const absl::Status& status, absl::string_view field) {
+  if (status.code() != absl::StatusCode::kInvalidArgument || !absl::StartsWith(status.message(), "name")) return status;
+  return absl::InvalidArgumentError(absl::StrCat(field, status.message().substr(4)));
+}
+
+void ProblemToProto(const storage::VerifyProblem& p, v1::CheckProblem& problem) {
+  problem.set_file(p.file);
+  problem.set_location(p.where);
+  problem.set_description(p.what);
+}
+
+void ScrubsToProto(const Scrubber& scrubber, v1::GetServerStatusResponse& response) {
+  if (const absl::Time next = scrubber.NextPass(); next != absl::InfiniteFuture()) {
+    TimeToProto(next, *response.mutable_next_scrub_time());
+  }
+  for (const Scrubber::Result& result : scrubber.Results()) {
+    v1::MapScrub& scrub = *response.add_map_scrubs();
+    scrub.set_map(result.map);
+    TimeToProto(result.finished, *scrub.mutable_finish_time());
+    scrub.set_duration_seconds(absl::ToDoubleSeconds(result.took));
+    scrub.set_clean(result.clean);
+    scrub.set_problem_count(result.problem_count);
+    for (const storage::VerifyProblem& p : result.problems) ProblemToProto(p, *scrub.add_problems());
+    scrub.set_records(result.records);
+  }
+}
+
+void VerifyReportToProto(const storage::VerifyReport& report, v1::CheckMapResponse& response) {
+  response.set_map(report.map);
+  response.set_clean(report.clean());
+  for (const storage::VerifyProblem& p : report.problems) ProblemToProto(p, *response.add_problems());
+  for (const std::string& note : report.notes) response.add_notes(note);
+  for (const storage::ShardVerifyReport& s : report.shards) {
+    v1::ShardCheck* shard = response.add_shards();
+    shard->set_shard(s.shard);
+    shard->set_records(s.records);
+    shard->set_record_bytes(s.record_bytes);
+    shard->set_file_bytes(s.file_bytes);
+    shard->set_checkpoint_lsn(s.checkpoint_lsn.value_or(0));
+    shard->set_read_to_end(s.read);
+  }
+  v1::LogCheck* log = response.mutable_log();
+  log->set_segments(report.log.segments);
+  log->set_records(report.log.records);
+  log->set_bytes(report.log.bytes);
+  log->set_first_lsn(report.log.first_lsn);
+  log->set_last_lsn(report.log.last_lsn);
+  log->set_torn_tail_bytes(report.log.torn_tail_bytes);
+}
+
+void SalvageReportToProto(const storage::SalvageReport& report, v1::SalvageMapResponse& response) {
+  MapInfoToProto(report.map, *response.mutable_map());
+  response.set_records_kept(report.records_kept());
+  response.set_records_lost(report.records_lost());
+  for (const storage::SalvageShard& s : report.shards) {
+    v1::ShardSalvage* shard = response.add_shards();
+    shard->set_shard(s.shard);
+    for (const storage::SalvageDatabase& d : s.databases) {
+      v1::DatabaseSalvage* db = shard->add_databases();
+      db->set_name(d.name);
+      db->set_kept(d.kept);
+      db->set_lost(d.lost);
+    }
+  }
+  response.set_log_records_kept(report.log.records_kept);
+  response.set_log_records_lost(report.log.records_lost);
+  response.set_log_bytes_lost(report.log.bytes_lost);
+  response.set_log_torn_tail_bytes(report.log.torn_tail_bytes);
+  for (const storage::VerifyProblem& p : report.lost) ProblemToProto(p, *response.add_lost());
+  response.set_losses(report.losses);
+}
+
+}  // namespace
+
+grpc::ServerUnaryReactor* AdminServiceImpl::RunUpdate(grpc::CallbackServerContext* context,
+                                                      const v1::RunUpdateRequest* request, v1::Operation* response) {
+  return ServeUnary(deps_, context, kRunUpdate, [this, context, request, response]() -> absl::Status {
+    auto name = ResolveMapName(*context, request->map(), "map");
+    if (!name.ok()) return name.status();
+    auto store = deps_.store->Get();
+    if (!store.ok()) return store.status();
+    if (auto info = (*store)->GetMap(*name); !info.ok()) return info.status();
+    auto op = admin_.operations->StartUpdate(*name, "RunUpdate");
+    if (!op.ok()) return op.status();
+    OperationToProto(*op, *response);
+    return absl::OkStatus();
+  });
+}
+
+absl::StatusOr<OperationView> AdminServiceImpl::FindOperation(const grpc::CallbackServerContext& context,
+                                                              const std::string& request_map,
+                                                              const std::string& name) const {
+  if (name.empty()) return absl::InvalidArgumentError("name is required");
+  if (!absl::StartsWith(name, kOperationPrefix)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("name: \"", name, "\" is not an operation name (", kOperationPrefix, "...)"));
+  }
+  auto map = OptionalMapName(context, request_map, "map");
+  if (!map.ok()) return map.status();
+  auto op = admin_.operations->Get(name);
+  if (!op.ok()) return op.status();
+  // A daemon answers only about the map a call was routed for (docs/storage.md, "Maps across
+  // daemons").
+  if (!map->empty() && op->map != *map) {
+    return absl::NotFoundError(absl::StrCat("no operation named \"", name, "\" on map \"", *map, "\""));
+  }
+  return op;
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::GetOperation(grpc::CallbackServerContext* context,
+                                                         const v1::GetOperationRequest* request,
+                                                         v1::Operation* response) {
+  return ServeUnary(deps_, context, kGetOperation, [this, context, request, response]() -> absl::Status {
+    auto op = FindOperation(*context, request->map(), request->name());
+    if (!op.ok()) return op.status();
+    OperationToProto(*op, *response);
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::ListOperations(grpc::CallbackServerContext* context,
+                                                           const v1::ListOperationsRequest* request,
+                                                           v1::ListOperationsResponse* response) {
+  return ServeUnary(deps_, context, kListOperations, [this, context, request, response]() -> absl::Status {
+    if (request->page_size() < 0) {
+      return absl::InvalidArgumentError(absl::StrCat("page_size must be ≥ 0, got ", request->page_size()));
+    }
+    const size_t page_size = request->page_size() == 0 ? storage::kDefaultPageSize
+                                                       : std::min<size_t>(request->page_size(), storage::kMaxPageSize);
+    auto map = OptionalMapName(*context, request->map(), "map");
+    if (!map.ok()) return map.status();
+    auto page = admin_.operations->List(*map, request->running_only(), page_size, request->page_token());
+    if (!page.ok()) return page.status();
+    for (const OperationView& view : page->operations) OperationToProto(view, *response->add_operations());
+    response->set_next_page_token(page->next_page_token);
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::CancelOperation(grpc::CallbackServerContext* context,
+                                                            const v1::CancelOperationRequest* request,
+                                                            v1::Operation* response) {
+  return ServeUnary(deps_, context, kCancelOperation, [this, context, request, response]() -> absl::Status {
+    auto found = FindOperation(*context, request->map(), request->name());
+    if (!found.ok()) return found.status();
+    auto op = admin_.operations->Cancel(found->name);
+    if (!op.ok()) return op.status();
+    OperationToProto(*op, *response);
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::BackupMap(grpc::CallbackServerContext* context,
+                                                      const v1::BackupMapRequest* request,
+                                                      v1::BackupMapResponse* response) {
+  return ServeUnary(deps_, context, kBackupMap, [this, context, request, response] {
+    return Backup(*request, *context, *response);
+  });
+}
+
+absl::Status AdminServiceImpl::Backup(const v1::BackupMapRequest& request, const grpc::CallbackServerContext& context,
+                                      v1::BackupMapResponse& response) const {
+  auto name = ResolveMapName(context, request.map(), "map");
+  if (!name.ok()) return name.status();
+  auto dir = ResolveBackupPath(admin_.config->backup_dir, request.directory(), "directory");
+  if (!dir.ok()) return dir.status();
+  auto store = deps_.store->Get();
+  if (!store.ok()) return store.status();
+  if (auto info = (*store)->GetMap(*name); !info.ok()) return info.status();
+  if (!ClaimBackupDir(*dir)) {
+    return absl::AlreadyExistsError(
+        absl::StrCat("directory: another backup is being written to \"", request.directory(), "\""));
+  }
+  const absl::Status status = BackupInto(*name, *dir, request.directory(), **store, response);
+  ReleaseBackupDir(*dir);
+  return status;
+}
+
+bool AdminServiceImpl::ClaimBackupDir(const std::string& dir) const {
+  base::MutexLock lock(&backups_mutex_);
+  return backups_in_progress_.insert(dir).second;
+}
+
+void AdminServiceImpl::ReleaseBackupDir(const std::string& dir) const {
+  base::MutexLock lock(&backups_mutex_);
+  backups_in_progress_.erase(dir);
+}
+
+absl::Status AdminServiceImpl::BackupInto(const std::string& name, const std::string& dir,
+                                          const std::string& requested_dir, storage::Store& store,
+                                          v1::BackupMapResponse& response) const {
+  std::error_code error;
+  const bool existed = fs::exists(dir, error);
+  if (existed && !(fs::is_directory(dir, error) && fs::is_empty(dir, error))) {
+    return absl::AlreadyExistsError(absl::StrCat("directory: \"", requested_dir,
+                                                 "\" already exists in the backup root and is not empty"));
+  }
+  if (fs::create_directories(fs::path(dir).parent_path(), error); error) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("backup_dir: cannot create ", fs::path(dir).parent_path().string(), ": ", error.message()));
+  }
+  const absl::Time start = admin_.clock->Now();
+  auto bytes = store.BackupMap(name, dir);
+  if (!bytes.ok()) {
+    // No half copy left to be mistaken for a backup.
+    fs::remove_all(dir, error);
+    if (existed) fs::create_directory(dir, error);
+    return bytes.status();
+  }
+  const absl::Duration took = admin_.clock->Now() - start;
+  response.set_path(dir);
+  response.set_bytes(*bytes);
+  response.set_duration_seconds(absl::ToDoubleSeconds(took));
+  DaemonLog()->info("backup of map {} to {}: {} bytes in {}", name, dir, *bytes, absl::FormatDuration(took));
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::RestoreMap(grpc::CallbackServerContext* context,
+                                                       const v1::RestoreMapRequest* request,
+                                                       v1::RestoreMapResponse* response) {
+  return ServeUnary(deps_, context, kRestoreMap, [this, context, request, response] {
+    return Restore(*request, *context, *response);
+  });
+}
+
+absl::Status AdminServiceImpl::Restore(const v1::RestoreMapRequest& request, const grpc::CallbackServerContext& context,
+                                       v1::RestoreMapResponse& response) const {
+  auto name = OptionalMapName(context, request.map(), "map");
+  if (!name.ok()) return name.status();
+  auto dir = ResolveBackupPath(admin_.config->backup_dir, request.directory(), "directory");
+  if (!dir.ok()) return dir.status();
+  std::error_code error;
+  if (!fs::is_directory(*dir, error)) {
+    return absl::NotFoundError(absl::StrCat("directory: no backup at \"", request.directory(), "\" in the backup root"));
+  }
+  auto store = deps_.store->Get();
+  if (!store.ok()) return store.status();
+  auto info = (*store)->RestoreMap(*dir, *name, CallDeadline(context));
+  if (absl::IsDataLoss(info.status()) || absl::IsDeadlineExceeded(info.status())) {
+    DaemonLog()->warn("restore refused: {}", std::string(info.status().message()));
+  }
+  if (!info.ok()) return RenameNameField(info.status(), "map");
+  MapInfoToProto(*info, *response.mutable_map());
+  DaemonLog()->info("map {} restored from {}", info->name, *dir);
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::CheckMap(grpc::CallbackServerContext* context,
+                                                     const v1::CheckMapRequest* request,
+                                                     v1::CheckMapResponse* response) {
+  return ServeUnary(deps_, context, kCheckMap, [this, context, request, response]() -> absl::Status {
+    auto name = ResolveMapName(*context, request->map(), "map");
+    if (!name.ok()) return name.status();
+    auto store = deps_.store->Get();
+    if (!store.ok()) return store.status();
+    auto map = (*store)->Map(*name);
+    if (!map.ok()) return map.status();
+    const absl::Time start = admin_.clock->Now();
+    const storage::VerifyReport report = (*map)->Verify(CallDeadline(*context));
+    if (report.deadline_exceeded) {
+      return absl::DeadlineExceededError(absl::StrCat("map ", *name, ": the check did not finish by the call's deadline (",
+                                                      storage::FormatProblem(report.problems.back()), ")"));
+    }
+    VerifyReportToProto(report, *response);
+    response->set_duration_seconds(absl::ToDoubleSeconds(admin_.clock->Now() - start));
+    if (report.clean()) {
+      DaemonLog()->info("check of map {}: clean", *name);
+    } else {
+      DaemonLog()->warn("check of map {}: {} problems, the first: {}", *name, report.problems.size(),
+                  storage::FormatProblem(report.problems.front()));
+    }
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::SalvageMap(grpc::CallbackServerContext* context,
+                                                       const v1::SalvageMapRequest* request,
+                                                       v1::SalvageMapResponse* response) {
+  return ServeUnary(deps_, context, kSalvageMap, [this, context, request, response]() -> absl::Status {
+    auto name = ResolveMapName(*context, request->map(), "map");
+    if (!name.ok()) return name.status();
+    auto store = deps_.store->Get();
+    if (!store.ok()) return store.status();
+    const absl::Time start = admin_.clock->Now();
+    auto report = (*store)->SalvageMap(*name, request->new_map(), CallDeadline(*context));
+    if (!report.ok()) {
+      DaemonLog()->warn("salvage of map {} failed: {}", *name, std::string(report.status().message()));
+      return RenameNameField(report.status(), "new_map");
+    }
+    SalvageReportToProto(*report, *response);
+    response->set_duration_seconds(absl::ToDoubleSeconds(admin_.clock->Now() - start));
+    DaemonLog()->warn("map {} salvaged as {}: {} records kept, {} lost; log: {} records kept, {} lost ({} bytes); {} losses",
+                *name, report->map.name, report->records_kept(), report->records_lost(), report->log.records_kept,
+                report->log.records_lost, report->log.bytes_lost, report->losses);
+    for (const storage::VerifyProblem& p : report->lost) {
+      DaemonLog()->warn("salvage of map {}: lost: {}", *name, storage::FormatProblem(p));
+    }
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::GetServerStatus(grpc::CallbackServerContext* context,
+                                                            const v1::GetServerStatusRequest* /*request*/,
+                                                            v1::GetServerStatusResponse* response) {
+  return ServeUnary(deps_, context, kGetServerStatus, [this, response] { return FillStatus(*response); });
+}
+
+absl::Status AdminServiceImpl::FillStatus(v1::GetServerStatusResponse& response) const {
+  const ServerConfig& config = *admin_.config;
+  response.set_version(FREMEN_VERSION);
+  TimeToProto(start_time_, *response.mutable_start_time());
+  response.set_uptime_seconds(absl::ToDoubleSeconds(admin_.clock->Now() - start_time_));
+  response.set_running_operations(static_cast<uint32_t>(admin_.operations->running()));
+  if (admin_.scheduler != nullptr) {
+    if (const absl::Time next = admin_.scheduler->NextRun(); next != absl::InfiniteFuture()) {
+      TimeToProto(next, *response.mutable_next_update_time());
+    }
+  }
+  response.set_update_schedule(config.update_schedule);
+  response.set_update_time_zone(config.update_time_zone);
+  response.set_tls(!config.tls_cert_pem.empty());
+  response.set_tokens_required(deps_.auth->enabled());
+  std::error_code error;
+  if (const fs::space_info space = fs::space(config.data_dir, error); !error) {
+    response.set_data_dir_free_bytes(space.available);
+  }
+  for (const OperationView& view : admin_.operations->LastUpdates()) OperationToProto(view, *response.add_last_updates());
+  // While the maps are recovered the status still answers: that is when an operator asks.
+  auto store = deps_.store->Get();
+  if (!store.ok()) {
+    response.set_store_state(v1::STORE_STATE_RECOVERING);
+    return absl::OkStatus();
+  }
+  response.set_store_state(v1::STORE_STATE_OPEN);
+  auto maps = ListAllMaps(**store);
+  if (!maps.ok()) return maps.status();
+  response.set_map_count(maps->size());
+  // Maps that did not open (their calls answer the error), then maps whose writes stopped.
+  for (const storage::FailedMap& failed_map : (*store)->FailedMaps()) {
+    v1::MapFault& failed = *response.add_failed_maps();
+    failed.set_map(failed_map.name);
+    failed.set_error(failed_map.status.ToString());
+  }
+  for (const std::string& dir : (*store)->UnknownDirectories()) response.add_unknown_directories(dir);
+  if (admin_.scrubber != nullptr) ScrubsToProto(*admin_.scrubber, response);
+  for (const storage::MapInfo& info : *maps) {
+    auto map = (*store)->Map(info.name);
+    if (!map.ok()) continue;  // deleted meanwhile, or failed (listed above)
+    if (const absl::Status fault = (*map)->WriteError(); !fault.ok()) {
+      v1::MapFault& failed = *response.add_failed_maps();
+      failed.set_map(info.name);
+      failed.set_error(fault.ToString());
+    }
+    const storage::MapStats stats = (*map)->Stats();
+    if (stats.last_update) {
+      v1::MapLastUpdate& last = *response.add_map_updates();
+      last.set_map(info.name);
+      UpdateRecordToProto(*stats.last_update, *last.mutable_update());
+    }
+    response.set_state_count(response.state_count() + stats.totals.states);
+    response.set_dynamic_state_count(response.dynamic_state_count() + stats.totals.dynamic_states);
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace fremen::server

@@ -1,0 +1,47 @@
+// Region prediction (docs/model.md, "Queries"): p(t) of many compact models at one time t.
+//
+// The per-query table cos ω_k t, sin ω_k t (float, from a PhasorTable built once per query in double
+// with range reduction) turns each state's prediction into l multiply-adds: no trigonometry per state
+// (docs/performance.md, "One scan shares its phasors": a cosf per cell is ~15x slower). float is
+// ample: the result is within ~1e-6 of PublishedModel::Predict's double, and a served probability is
+// float or a byte anyway.
+// Thread-safety: pure functions; concurrent calls on the same unchanging CompactModels are fine.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "storage/model/kernels/compact_models.h"
+#include "storage/model/phasor.h"
+
+namespace fremen::model {
+
+// A probability in [0, 1] as the byte round(p·255), the wire form of a region result (a quarter of a
+// float's bandwidth; resolution 1/255, finer than any model's accuracy).
+inline uint8_t QuantizeProbability(float p) { return static_cast<uint8_t>(p * 255.0f + 0.5f); }
+
+// out[i] = p(t) of record first + i, for i < count, clamped to [0, 1]. `order`: -1 for each state's
+// selected order, else that order for all (an order above L uses all components).
+// REQUIRES: phasors of the models' Ω; first + count <= models.size().
+void PredictRegion(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order,
+                   float* out);
+// The same, quantised (QuantizeProbability).
+void PredictRegionU8(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order,
+                     uint8_t* out);
+
+// out[i] = p(t) of record records[i], for i < records.size(), clamped to [0, 1]: the same kernel for
+// records that are not consecutive (the cells of a box, as a shard holds them). `order` as above.
+// REQUIRES: phasors of the models' Ω; every records[i] < models.size().
+void PredictRecords(const CompactModels& models, std::span<const uint32_t> records, const PhasorTable& phasors,
+                    int order, float* out);
+
+// Every record of `models`.
+inline void PredictRegion(const CompactModels& models, const PhasorTable& phasors, int order, float* out) {
+  PredictRegion(models, 0, models.size(), phasors, order, out);
+}
+inline void PredictRegionU8(const CompactModels& models, const PhasorTable& phasors, int order, uint8_t* out) {
+  PredictRegionU8(models, 0, models.size(), phasors, order, out);
+}
+
+}  // namespace fremen::model
