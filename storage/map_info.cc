@@ -66,6 +66,11 @@ absl::Status ValidateMapInfo(const MapInfo& info) {
       }
     }
   }
+  // Checked even where explicit periods make the count unused: the catalog's encoding keeps at
+  // most 65535, and a record it could not decode would fail the map at the next start.
+  if (info.periods.count > 65535) {
+    return absl::InvalidArgumentError(absl::StrCat("periods: period count must be in [1, 65535], got ", info.periods.count));
+  }
   if (!info.periods.explicit_periods.empty()) {
     if (auto p = model::PeriodSet::FromPeriods(info.periods.explicit_periods); !p.ok()) {
       return absl::InvalidArgumentError(absl::StrCat("periods.", p.status().message()));

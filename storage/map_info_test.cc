@@ -46,6 +46,10 @@ TEST(MapInfoTest, ValidationNamesTheField) {
   bad.periods.count = 0;
   EXPECT_NE(message_of(bad).find("periods"), std::string::npos);
   bad = Office();
+  bad.periods.count = 65536;  // more than the catalog's encoding keeps: refused even when unused
+  bad.periods.explicit_periods = {86400, 3600};
+  EXPECT_EQ(message_of(bad), "periods: period count must be in [1, 65535], got 65536");
+  bad = Office();
   bad.error_half_life = NAN;
   EXPECT_NE(message_of(bad).find("error_half_life"), std::string::npos);
   EXPECT_TRUE(ValidateMapInfo(Office()).ok());
