@@ -246,6 +246,9 @@ std::vector<ConfigField> MakeConfigFields() {
                     }
                     return Invalid(absl::StrCat(Quoted(value), " is not one of ", absl::StrJoin(kLogLevels, ", ")));
                   }),
+      BoolField("test_publication_waits_for_a_batch",
+                "tests only: an update's publication waits for a batch before its first slice",
+                &C::test_publication_waits_for_a_batch),
   };
 }
 

@@ -96,6 +96,10 @@ struct ServerConfig {
   absl::Duration scrub_map_timeout = absl::Hours(1);
   // trace, debug, info, warn, error, critical or off.
   std::string log_level = "info";
+  // Tests only: an update's publication waits before its first slice until a batch has been
+  // applied and acknowledged, so that an end-to-end test sees, in order rather than by timing,
+  // that ingest and queries are served while a job publishes. Default: false.
+  bool test_publication_waits_for_a_batch = false;
 
   // Filled by FinishConfig from the files named above.
   std::string tls_cert_pem;

@@ -192,6 +192,7 @@ absl::Status Daemon::OpenStore() {
   storage::StoreOptions options;
   options.default_shards = config_.shards;
   options.checkpoint_log_bytes = config_.checkpoint_log_mb << 20;
+  options.publication_waits_for_a_batch = config_.test_publication_waits_for_a_batch;
   const auto store_log = NamedLogger(kStoreLogger);
   // What recovery repairs on its own (a torn log tail cut) is logged at warning.
   options.log_warning = [store_log](const std::string& line) { store_log->warn("{}", line); };
