@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "fuzz/fuzz_map.h"
 #include "fuzz/fuzz_util.h"
 #include "storage/batch.h"
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fremen/v1/ingest.pb.h"
+#include "fuzz/fuzz_map.h"
 #include "fuzz/fuzz_util.h"
 #include "server/convert/ingest_convert.h"
 #include "storage/batch.h"

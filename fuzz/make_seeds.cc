@@ -16,6 +16,7 @@
 #include "fremen/v1/ingest.pb.h"
 #include "fremen/v1/maps.pb.h"
 #include "fremen/v1/query.pb.h"
+#include "fuzz/fuzz_map.h"
 #include "fuzz/fuzz_util.h"
 #include "storage/batch.h"
 #include "storage/dedup_table.h"

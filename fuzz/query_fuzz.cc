@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fremen/v1/query.pb.h"
+#include "fuzz/fuzz_map.h"
 #include "fuzz/fuzz_util.h"
 #include "server/convert/query_args.h"
 #include "server/convert/query_convert.h"

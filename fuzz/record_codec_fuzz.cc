@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "fuzz/fuzz_map.h"
 #include "fuzz/fuzz_util.h"
 #include "storage/map_info.h"
 #include "storage/model/lossless/lossless_history.h"

@@ -61,13 +61,10 @@ void GridFromProto(const v1::GridGeometry& grid, storage::GridGeometry& out) {
 }
 
 void PeriodsFromProto(const v1::PeriodSpec& periods, storage::PeriodSpec& out) {
-  out.explicit_periods.assign(periods.explicit_seconds().begin(), periods.explicit_seconds().end());
-  // Explicit periods make the other three fields unused (the proto says they are ignored): they
-  // keep their defaults rather than whatever the request held.
-  if (!out.explicit_periods.empty()) return;
   if (periods.has_longest_seconds()) out.longest = periods.longest_seconds();
   if (periods.has_count()) out.count = periods.count();
   out.floor_periods = periods.floor_periods();
+  out.explicit_periods.assign(periods.explicit_seconds().begin(), periods.explicit_seconds().end());
 }
 
 }  // namespace

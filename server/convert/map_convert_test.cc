@@ -76,27 +76,23 @@ TEST(MapConvertTest, RoundTripsEveryField) {
   EXPECT_EQ(*back, info);
 }
 
-// The proto ignores longest, count and floor when explicit periods are given: whatever they hold,
-// the map is created with their defaults, and its catalog record decodes again (a count beyond
-// what the record keeps once made a map that failed at the next start).
-TEST(MapConvertTest, ExplicitPeriodsIgnoreTheHarmonicFieldsAndTheMapSurvivesTheCatalog) {
+// Explicit periods leave the harmonic fields unused, but they are kept (GetMap shows them as
+// given), so the count must still fit the catalog's record: a count beyond it once made a map that
+// was created and then failed at the next start, its record undecodable.
+TEST(MapConvertTest, APeriodCountTheCatalogCannotKeepIsRefusedEvenWithExplicitPeriods) {
   v1::Map map = GridMap();
   map.mutable_periods()->set_count(4294967240u);
-  map.mutable_periods()->set_longest_seconds(-3);
-  map.mutable_periods()->set_floor_periods(true);
+  map.mutable_periods()->add_explicit_seconds(86400);
+  EXPECT_EQ(ErrorOf(map), "map.periods.count: must be in [1, 65535], got 4294967240");
+
+  map = GridMap();
+  map.mutable_periods()->set_count(65535);
   map.mutable_periods()->add_explicit_seconds(86400);
   auto info = MapInfoFromProto(map);
   ASSERT_TRUE(info.ok()) << info.status();
-  EXPECT_EQ(info->periods.count, storage::PeriodSpec().count);
-  EXPECT_EQ(info->periods.longest, storage::PeriodSpec().longest);
-  EXPECT_FALSE(info->periods.floor_periods);
   auto decoded = storage::DecodeMapInfo(storage::EncodeMapInfo(*info));
   ASSERT_TRUE(decoded.ok()) << decoded.status();
   EXPECT_EQ(*decoded, *info);
-
-  map = GridMap();
-  map.mutable_periods()->set_count(70000);
-  EXPECT_EQ(ErrorOf(map), "map.periods.count: must be in [1, 65535], got 70000");
 }
 
 TEST(MapConvertTest, GenericMapRoundTripsWithoutGrid) {
