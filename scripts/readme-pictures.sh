@@ -8,7 +8,7 @@ BIN=${1:-build}/bin
 OUT=$(cd "$(dirname "$0")/.." && pwd)/docs
 WORK=$(mktemp -d)
 trap 'kill $(cat "$WORK/pid") 2>/dev/null || true; rm -rf "$WORK"' EXIT
-"$BIN/fremend" --data-dir "$WORK/data" --listen 127.0.0.1:0 --log-level info > "$WORK/log" 2>&1 &
+"$BIN/fremend" --data-dir "$WORK/data" --listen 127.0.0.1:0 --http-listen 127.0.0.1:0 --log-level info > "$WORK/log" 2>&1 &
 echo $! > "$WORK/pid"
 for _ in $(seq 100); do grep -q "listening on" "$WORK/log" && break; sleep 0.1; done
 export FREMEN_ADDRESS=$(grep -o "listening on [^ ]*" "$WORK/log" | head -1 | cut -d' ' -f3)

@@ -103,6 +103,10 @@ absl::StatusOr<std::unique_ptr<FremendProcess>> FremendProcess::Start(
   if (std::find(args.begin(), args.end(), "--listen") == args.end()) {
     all_args.insert(all_args.end(), {"--listen", "127.0.0.1:0"});
   }
+  // The HTTP port too: the default one would be shared by every daemon of a parallel test run.
+  if (std::find(args.begin(), args.end(), "--http-listen") == args.end()) {
+    all_args.insert(all_args.end(), {"--http-listen", "127.0.0.1:0"});
+  }
   all_args.insert(all_args.end(), args.begin(), args.end());
   // The log sits beside the data directory, so that it survives the daemon for the test to read.
   static int starts = 0;
@@ -126,6 +130,12 @@ absl::Status FremendProcess::AwaitServing() {
     if (const size_t at = log.find(kListening); at != std::string::npos) {
       const size_t start = at + kListening.size();
       address_ = log.substr(start, log.find(',', start) - start);
+      // Logged before the line above, when the daemon has an HTTP port.
+      constexpr std::string_view kHttp = "serving HTTP on ";
+      if (const size_t http = log.find(kHttp); http != std::string::npos) {
+        const size_t from = http + kHttp.size();
+        http_address_ = log.substr(from, log.find_first_of(" \n", from) - from);
+      }
       break;
     }
     if (Reap(false)) return absl::FailedPreconditionError(absl::StrCat("fremend exited with code ", exit_code_));

@@ -1,8 +1,8 @@
 // End-to-end test support: the real fremend binary (FREMEND_BINARY, set by CMake) run as a child
 // process on a free loopback port, with a data directory the test owns, and gRPC channels to it.
 //
-// FremendProcess::Start passes --listen 127.0.0.1:0 (the daemon logs the port it was given) unless
-// the test's args have a --listen of their own (FreeLoopbackPort: a daemon restarted on the same
+// FremendProcess::Start passes --listen 127.0.0.1:0 and --http-listen 127.0.0.1:0 (the daemon logs the
+// ports it was given) unless the test's args have their own (FreeLoopbackPort: a daemon restarted on the same
 // address, as its clients expect),
 // sends the daemon's output to a log file, and returns once the daemon has logged its address and
 // the health service says SERVING. Stop() sends SIGTERM and returns the exit code; Kill() is
@@ -55,6 +55,8 @@ class FremendProcess {
   ~FremendProcess();
 
   const std::string& address() const { return address_; }
+  // HOST:PORT of its HTTP port ("" when it has none: --http-listen "").
+  const std::string& http_address() const { return http_address_; }
   pid_t pid() const { return pid_; }
   // A new channel to the daemon, with the credentials Start was given.
   std::shared_ptr<grpc::Channel> NewChannel() const;
@@ -78,6 +80,7 @@ class FremendProcess {
   const std::string log_path_;
   std::shared_ptr<grpc::ChannelCredentials> credentials_;
   std::string address_;
+  std::string http_address_;
   bool running_ = true;
   int exit_code_ = -1;
 };

@@ -188,6 +188,9 @@ std::vector<ConfigField> MakeConfigFields() {
   };
   return {
       StringField("listen", "HOST:PORT", "HOST:PORT to serve gRPC on (port 0: any free port)", &C::listen, CheckHostPort),
+      StringField("http_listen", "HOST:PORT",
+                  "HOST:PORT of the HTTP port: metrics, health, JSON API, dashboard (empty: none)", &C::http_listen,
+                  [](absl::string_view value) { return value.empty() ? absl::OkStatus() : CheckHostPort(value); }),
       StringField("data_dir", "DIR", "directory of the catalog and the maps' files (created when missing)", &C::data_dir,
                   non_empty),
       StringField("backup_dir", "DIR", "root of BackupMap/RestoreMap directories (empty: DATA_DIR/backups)",

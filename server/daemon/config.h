@@ -44,6 +44,9 @@ struct ServerConfig {
   // HOST:PORT to serve gRPC on; IPv6 hosts in brackets ("[::1]:50051"); port 0 = any free port
   // (the chosen one is logged). Default: loopback only — exposing the daemon is a decision.
   std::string listen = "127.0.0.1:50051";
+  // HOST:PORT of the HTTP port (server/http/): /metrics, /healthz and /readyz, the JSON API and the
+  // dashboard, with the same TLS and tokens as gRPC; port 0 = any free port; "" = no HTTP port.
+  std::string http_listen = "127.0.0.1:50052";
   // Where the catalog and every map's files live; created when missing.
   std::string data_dir = "./fremen-data";
   // Root of BackupMap/RestoreMap directories; "" = <data_dir>/backups.

@@ -28,6 +28,7 @@ TEST(ConfigTest, DefaultsAreValid) {
   ServerConfig config;
   ASSERT_TRUE(FinishConfig(config).ok());
   EXPECT_EQ(config.listen, "127.0.0.1:50051");
+  EXPECT_EQ(config.http_listen, "127.0.0.1:50052");
   EXPECT_EQ(config.data_dir, "./fremen-data");
   EXPECT_EQ(config.update_schedule, "0 0 * * *");
   EXPECT_EQ(config.keepalive_time, absl::Seconds(20));
@@ -74,6 +75,15 @@ TEST(ConfigTest, AcceptsListenAddressesOfEveryForm) {
     ServerConfig config;
     EXPECT_TRUE(SetConfigValue("listen", listen, "--listen", config).ok()) << listen;
   }
+}
+
+TEST(ConfigTest, TheHttpPortTakesAnAddressOrNothing) {
+  ServerConfig config;
+  ASSERT_TRUE(SetConfigValue("http_listen", "", "--http-listen", config).ok());
+  EXPECT_EQ(config.http_listen, "");
+  ASSERT_TRUE(SetConfigValue("http_listen", "[::1]:0", "--http-listen", config).ok());
+  EXPECT_EQ(config.http_listen, "[::1]:0");
+  EXPECT_THAT(ErrorOf("http_listen = 8080"), HasSubstr("config: http_listen: \"8080\" is not HOST:PORT"));
 }
 
 TEST(ConfigTest, BadValuesAreNamedWithWhereTheyCameFrom) {

@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "server/http/health_routes.h"
 #include "server/services/admin_service.h"
 #include "server/services/ingest_service.h"
 #include "server/rpc/logging.h"
@@ -74,6 +75,7 @@ absl::Status Daemon::Start() {
   if (absl::Status s = PrepareDirectories(); !s.ok()) return s;
   if (absl::Status s = PrepareUpdates(); !s.ok()) return s;
   if (absl::Status s = StartServer(); !s.ok()) return s;
+  if (absl::Status s = StartHttp(); !s.ok()) return s;
   if (absl::Status s = OpenStore(); !s.ok()) return s;
   SetServing(true);
   scheduler_->Start();
@@ -168,6 +170,28 @@ absl::Status Daemon::StartServer() {
   return absl::OkStatus();
 }
 
+absl::Status Daemon::StartHttp() {
+  if (config_.http_listen.empty()) {
+    DaemonLog()->info("no HTTP port (http_listen is empty)");
+    return absl::OkStatus();
+  }
+  http_ = std::make_unique<HttpServer>(HttpServer::Options{config_.http_listen, config_.tls_cert_file,
+                                                           config_.tls_key_file, config_.tls_client_ca_file});
+  AddHttpRoutes(http_->routes());
+  if (absl::Status s = http_->Start(); !s.ok()) return s;
+  DaemonLog()->info("serving HTTP on {}{} (/metrics, /healthz, /readyz)", http_->address(),
+                    http_->tls() ? " with TLS" : "");
+  return absl::OkStatus();
+}
+
+// Every route of the HTTP port.
+void Daemon::AddHttpRoutes(httplib::Server& routes) {
+  AddHealthRoutes(routes, [this]() -> std::string {
+    if (serving_) return "";
+    return stopped_ ? "shutting down" : "recovering the maps";
+  });
+}
+
 absl::Status Daemon::PrepareUpdates() {
   operations_ = std::make_unique<OperationRegistry>(StoreUpdateJob(&store_handle_), RealClock::Get());
   auto scheduler = NewStoreUpdateScheduler(config_, RealClock::Get(), &store_handle_, operations_.get());
@@ -218,6 +242,7 @@ absl::Status Daemon::OpenStore() {
 }
 
 void Daemon::SetServing(bool serving) {
+  serving_ = serving;
   grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService();
   for (const std::string& name : service_names_) health->SetServingStatus(name, serving);
 }
@@ -230,6 +255,7 @@ absl::Status Daemon::Stop() {
   if (server_ != nullptr) {
     DaemonLog()->info("stopping: NOT_SERVING, no new calls, up to {} for the calls in flight",
                 absl::FormatDuration(config_.shutdown_grace));
+    serving_ = false;
     server_->GetHealthCheckService()->Shutdown();  // every service NOT_SERVING, for good
     if (const int64_t left = calls_.Drain(config_.shutdown_grace); left > 0) {
       DaemonLog()->warn("{} calls still in flight after {}: cancelling them", left,
@@ -237,6 +263,7 @@ absl::Status Daemon::Stop() {
     }
     server_->Shutdown(std::chrono::system_clock::now());
   }
+  if (http_ != nullptr) http_->Stop();
   blocking_.Stop();
   // A publication under way finishes (it is short and atomic in the log); queued updates are cancelled.
   if (operations_ != nullptr) operations_->Stop();

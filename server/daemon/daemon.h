@@ -1,11 +1,12 @@
 // fremend's life: Start() brings the daemon up step by step, each step checked and logged, and
 // Stop() takes it down in reverse.
 //
-// Start: data directory (created, locked against a second daemon) → credentials → gRPC server listening, health NOT_SERVING → store opened
+// Start: data directory (created, locked against a second daemon) → credentials → gRPC server listening, health NOT_SERVING
+// → HTTP port listening (server/http/: /readyz says 503 until serving) → store opened
 // (recovery: every map's checkpoint, then its log) → health SERVING → update schedule. Calls that arrive during
 // recovery get UNAVAILABLE (server/rpc/store_handle.h).
-// Stop: update schedule stopped → health NOT_SERVING and new calls refused (UNAVAILABLE) → the calls in flight get up to
-// shutdown_grace to finish → gRPC shuts down at once, cancelling what is left → the blocking pool
+// Stop: update schedule stopped → health NOT_SERVING, /readyz 503, and new calls refused (UNAVAILABLE) → the calls in
+// flight get up to shutdown_grace to finish → gRPC shuts down at once, cancelling what is left → the HTTP port closes → the blocking pool
 // finishes its work → update jobs end (a publication under way finishes) → the store finishes queued writes and checkpoints.
 //
 // The services served are added in one place, Daemon::AddServices.
@@ -14,6 +15,7 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,9 +23,10 @@
 #include "absl/status/status.h"
 #include "server/rpc/auth.h"
 #include "server/rpc/blocking_pool.h"
-#include "server/rpc/call_tracker.h"
 #include "server/daemon/config.h"
 #include "server/daemon/data_dir_lock.h"
+#include "server/http/http_server.h"
+#include "server/rpc/call_tracker.h"
 #include "server/jobs/operations.h"
 #include "server/rpc/store_handle.h"
 #include "server/rpc/unary_call.h"
@@ -45,6 +48,8 @@ class Daemon {
 
   // HOST:PORT the server listens on (the port chosen, when the config said 0).
   const std::string& address() const { return address_; }
+  // HOST:PORT of the HTTP port; "" when http_listen is empty.
+  std::string http_address() const { return http_ == nullptr ? "" : http_->address(); }
 
  private:
   absl::Status PrepareDirectories();
@@ -52,6 +57,9 @@ class Daemon {
   void AddServices(grpc::ServerBuilder& builder);
   void SetChannelArguments(grpc::ServerBuilder& builder) const;
   absl::Status StartServer();
+  // The HTTP port and its routes, when http_listen is set.
+  absl::Status StartHttp();
+  void AddHttpRoutes(httplib::Server& routes);
   absl::Status OpenStore();
   // The update jobs' registry and schedule, and the background scrub, for the admin service.
   absl::Status PrepareUpdates();
@@ -73,7 +81,9 @@ class Daemon {
   std::vector<std::string> service_names_;  // for health: each service, and "" for the whole server
   std::unique_ptr<grpc::Server> server_;
   std::string address_;
-  bool stopped_ = false;
+  std::unique_ptr<HttpServer> http_;  // its handlers call into server_: stopped after it drains
+  std::atomic<bool> serving_ = false;  // what health says, for /readyz
+  std::atomic<bool> stopped_ = false;  // read by /readyz
 };
 
 }  // namespace fremen::server

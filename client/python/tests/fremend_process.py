@@ -50,7 +50,8 @@ class FremendProcess:
         log_path = f"{data_dir}.fremend-{time.monotonic_ns()}.log"
         with open(log_path, "wb") as log:
             process = subprocess.Popen(
-                [fremend_binary(), "--listen", listen, "--data-dir", data_dir, *args],
+                [fremend_binary(), "--listen", listen, "--http-listen", "127.0.0.1:0",
+                 "--data-dir", data_dir, *args],
                 stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
         daemon = cls(process, log_path)
         try:
