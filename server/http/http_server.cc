@@ -1,5 +1,7 @@
 #include "server/http/http_server.h"
 
+#include <sys/socket.h>
+
 #include <chrono>
 #include <utility>
 
@@ -25,6 +27,13 @@ std::unique_ptr<httplib::Server> NewServer(const HttpServer::Options& options) {
 }  // namespace
 
 HttpServer::HttpServer(Options options) : options_(std::move(options)), server_(NewServer(options_)) {
+  // httplib's default also sets SO_REUSEPORT, with which a second daemon on the same port would
+  // start and share the connections instead of failing; SO_REUSEADDR alone lets a restart rebind
+  // while old connections linger in TIME_WAIT.
+  server_->set_socket_options([](socket_t sock) {
+    const int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
   server_->set_read_timeout(kIoTimeoutSeconds);
   server_->set_write_timeout(kIoTimeoutSeconds);
 }
