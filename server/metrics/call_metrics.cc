@@ -31,6 +31,11 @@ void CallMetrics::CallFinished(absl::string_view method, grpc::StatusCode code, 
   durations_.Add({{"method", name}}, LatencyBuckets()).Observe(absl::ToDoubleSeconds(took));
 }
 
+void CallMetrics::MapOpened(const std::string& map) {
+  ingest_bytes_.Add({{"map", map}});
+  ingest_waits_.Add({{"map", map}});
+}
+
 void CallMetrics::IngestReceived(const std::string& map, uint64_t bytes) {
   ingest_bytes_.Add({{"map", map}}).Increment(static_cast<double>(bytes));
 }

@@ -25,6 +25,8 @@ class CallMetrics final : public CallObserver {
   void CallFinished(absl::string_view method, grpc::StatusCode code, absl::Duration took) override;
   void IngestReceived(const std::string& map, uint64_t bytes) override;
   void IngestWaited(const std::string& map, absl::Duration took) override;
+  // Exports the map's ingest series from 0 on, before its first message (a rate needs a start).
+  void MapOpened(const std::string& map);
 
  private:
   prometheus::Family<prometheus::Counter>& calls_;

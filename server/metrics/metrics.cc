@@ -10,7 +10,7 @@ namespace fremen::server {
 Metrics::Metrics()
     : registry_(std::make_shared<prometheus::Registry>()),
       calls_(*registry_),
-      store_(*registry_),
+      store_(*registry_, [this](const std::string& map) { calls_.MapOpened(map); }),
       jobs_(*registry_) {}
 
 void Metrics::Watch(const StoreHandle* store, const OperationRegistry* operations) {

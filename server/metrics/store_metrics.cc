@@ -1,5 +1,7 @@
 #include "server/metrics/store_metrics.h"
 
+#include <utility>
+
 #include "server/metrics/buckets.h"
 
 namespace fremen::server {
@@ -72,7 +74,7 @@ prometheus::Family<prometheus::Histogram>& Histogram(prometheus::Registry& regis
 
 }  // namespace
 
-StoreMetrics::StoreMetrics(prometheus::Registry& registry)
+StoreMetrics::StoreMetrics(prometheus::Registry& registry, std::function<void(const std::string&)> opened)
     : batches_(Counter(registry, "fremen_ingest_batches_total",
                        "Ingest batches answered by the store, by map and result (applied, duplicate, refused)")),
       observations_(Counter(registry, "fremen_ingest_observations_total",
@@ -92,9 +94,11 @@ StoreMetrics::StoreMetrics(prometheus::Registry& registry)
       recovery_seconds_(prometheus::BuildGauge()
                             .Name("fremen_recovery_duration_seconds")
                             .Help("Duration of the map's last recovery (checkpoint load and log replay), by map")
-                            .Register(registry)) {}
+                            .Register(registry)),
+      opened_(std::move(opened)) {}
 
 std::shared_ptr<storage::MapObserver> StoreMetrics::ForMap(const std::string& map) {
+  if (opened_) opened_(map);
   const prometheus::Labels labels = {{"map", map}};
   const auto with = [&](const char* result) {
     return prometheus::Labels{{"map", map}, {"result", result}};

@@ -22,6 +22,7 @@
 #include <prometheus/histogram.h>
 #include <prometheus/registry.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -32,7 +33,8 @@ namespace fremen::server {
 class StoreMetrics final : public storage::StoreObserver {
  public:
   // The families are added to `registry`, which must outlive this and every map's observer.
-  explicit StoreMetrics(prometheus::Registry& registry);
+  // `opened` (may be empty) is told of each map ForMap is asked for.
+  StoreMetrics(prometheus::Registry& registry, std::function<void(const std::string&)> opened);
 
   std::shared_ptr<storage::MapObserver> ForMap(const std::string& map) override;
 
@@ -48,6 +50,7 @@ class StoreMetrics final : public storage::StoreObserver {
   prometheus::Family<prometheus::Histogram>& checkpoint_seconds_;
   prometheus::Family<prometheus::Counter>& checkpoint_bytes_;
   prometheus::Family<prometheus::Gauge>& recovery_seconds_;
+  const std::function<void(const std::string&)> opened_;
 };
 
 }  // namespace fremen::server
