@@ -8,10 +8,9 @@
 //   fremen_lmdb_map_size_bytes, fremen_lmdb_readers{map}, fremen_lmdb_growths_total{map}
 //   fremen_maps (open maps), fremen_failed_maps (maps that did not open; their reasons are in
 //   GetServerStatus and the log: a reason label would make a series per message)
-// Cost: Stats walks every state of the map under its shards' read locks (as GetMapStats does) —
-// about a millisecond per 100k states, so a scrape of a map of 10M states costs ~0.1 s of one
-// core and delays the map's writers as little as a GetMapStats does. A daemon of very large maps
-// wants a longer scrape_interval (15 s is Prometheus's default, and fine).
+// Cost: Stats walks every state of the map under its shards' read locks (as GetMapStats does):
+// a scrape costs one GetMapStats per map, linear in the states. A daemon of very large maps wants
+// a longer scrape_interval rather than a shorter one (docs/http.md, "What a scrape costs").
 // While the store is being recovered there are no maps yet: only fremen_maps 0 is exported.
 // Thread-safety: Collect may be called from any thread.
 #pragma once
