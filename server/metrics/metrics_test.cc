@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "server/metrics/sample_lookup.h"
 #include "storage/store.h"
 #include "storage/testing/scans.h"
 #include "testing/temp_dir.h"
@@ -19,28 +20,7 @@
 namespace fremen::server {
 namespace {
 
-using Labels = std::map<std::string, std::string>;
-
-// The value of the sample of family `name` whose labels are exactly `labels` (a histogram: its
-// count); nullopt when there is none.
-std::optional<double> Sample(const std::vector<prometheus::MetricFamily>& families, const std::string& name,
-                             const Labels& labels = {}) {
-  for (const prometheus::MetricFamily& family : families) {
-    if (family.name != name) continue;
-    for (const prometheus::ClientMetric& metric : family.metric) {
-      Labels have;
-      for (const auto& label : metric.label) have[label.name] = label.value;
-      if (have != labels) continue;
-      switch (family.type) {
-        case prometheus::MetricType::Counter: return metric.counter.value;
-        case prometheus::MetricType::Gauge: return metric.gauge.value;
-        case prometheus::MetricType::Histogram: return static_cast<double>(metric.histogram.sample_count);
-        default: return std::nullopt;
-      }
-    }
-  }
-  return std::nullopt;
-}
+using Labels = SampleLabels;
 
 TEST(MetricsTest, StoreWritesAndMapsAreExported) {
   Metrics metrics;
