@@ -1,8 +1,9 @@
 // GET /metrics end to end: a real fremend fed over gRPC, scraped over HTTP with cpp-httplib's
 // client. The ingest counters equal what was sent, each method's calls are counted by status code
-// (an error included), the per-map gauges follow the map, the read token is required when tokens
-// are configured (401 without or with an unknown one, 200 with a read or write token), and every
-// metric the Grafana dashboard (deploy/grafana-fremen.json) queries is one the daemon exports.
+// (an error included), the per-map gauges follow the map, an update job is counted with what it
+// published, the read token is required when tokens are configured (401 without or with an unknown
+// one, 200 with a read or write token), and every metric the Grafana dashboard
+// (deploy/grafana-fremen.json) queries is one the daemon exports.
 #include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
 
@@ -13,6 +14,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "fremen/v1/admin.grpc.pb.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/metrics_helpers.h"
@@ -73,6 +75,32 @@ TEST_F(HttpMetricsTest, TheMetricsOfARecoveredMapCarryItsRecovery) {
   EXPECT_THAT(text, HasSubstr("fremen_map_observations{map=\"lab\"} 100\n"));  // recovered, not re-ingested
   EXPECT_THAT(text, HasSubstr("fremen_ingest_observations_total{map=\"lab\"} 0\n"));  // counters restart
   EXPECT_THAT(text, HasSubstr("fremen_checkpoints_total{map=\"lab\"} 0\n"));
+}
+
+TEST_F(HttpMetricsTest, AnUpdateJobIsCountedWithTheStatesItPublished) {
+  CreateGridMap(*daemon_, "lab");
+  IngestCells(*daemon_, "lab", 4, 200);
+  auto admin = v1::AdminService::NewStub(daemon_->NewChannel());
+  v1::RunUpdateRequest run;
+  run.set_map("lab");
+  v1::Operation operation;
+  ASSERT_TRUE(admin->RunUpdate(CallContext().get(), run, &operation).ok());
+  // Polled until done; the job's own pace, not a timed assertion (a hung job fails at ctest's timeout).
+  while (!operation.done()) {
+    v1::GetOperationRequest get;
+    get.set_map("lab");
+    get.set_name(operation.name());
+    ASSERT_TRUE(admin->GetOperation(CallContext().get(), get, &operation).ok());
+  }
+  ASSERT_EQ(operation.error().code(), 0) << operation.error().message();
+  const std::string text = Scrape();
+  EXPECT_THAT(text, HasSubstr("fremen_update_jobs_total{result=\"ok\"} 1\n"));
+  EXPECT_THAT(text, HasSubstr("fremen_update_jobs_total{result=\"failed\"} 0\n"));
+  EXPECT_THAT(text, HasSubstr(absl::StrCat("fremen_update_states_published_total ",
+                                           operation.update().states_published(), "\n")));
+  EXPECT_THAT(text, HasSubstr("fremen_update_job_duration_seconds_count 1\n"));
+  EXPECT_THAT(text, HasSubstr("fremen_update_jobs_active 0\n"));
+  EXPECT_THAT(text, HasSubstr("fremen_grpc_calls_total{code=\"OK\",method=\"RunUpdate\"} 1\n"));
 }
 
 class HttpMetricsTokenTest : public HttpMetricsTest {
