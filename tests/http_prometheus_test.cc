@@ -66,17 +66,21 @@ class PrometheusProcess {
     }
   }
   ~PrometheusProcess() {
-    if (pid_ <= 0) return;
+    if (pid_ <= 0 || exited_) return;
     kill(pid_, SIGTERM);
     int status = 0;
     waitpid(pid_, &status, 0);
   }
   bool started() const { return pid_ > 0; }
-  // Whether it is still running.
-  bool running() const { return pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) == 0; }
+  // Whether it is still running (once it has exited, it is reaped and never signalled).
+  bool running() {
+    if (pid_ > 0 && !exited_ && waitpid(pid_, nullptr, WNOHANG) != 0) exited_ = true;
+    return pid_ > 0 && !exited_;
+  }
 
  private:
   pid_t pid_ = -1;
+  bool exited_ = false;
 };
 
 std::string ReadFile(const std::string& path) {
