@@ -16,6 +16,7 @@ packages=(
   python3-setuptools python3-wheel python3-venv  # the Python package's wheel, built and installed by python.test_package
   mypy python3-pycodestyle  # the Python package's type and style checks (python.mypy, python.pycodestyle)
   openssl  # the tests make their TLS certificates with it
+  prometheus  # e2e.HttpPrometheusTest: a real Prometheus scrapes fremend's /metrics
 )
 case "${1:-}" in
   fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;  # libclang_rt.fuzzer, asan and ubsan for clang

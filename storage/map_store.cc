@@ -12,6 +12,7 @@
 
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "storage/cell_key.h"
 #include "storage/parallel_shards.h"
 
@@ -42,8 +43,39 @@ bool IsQueueFull(const absl::Status& status) {
   return status.code() == absl::StatusCode::kResourceExhausted && status.GetPayload(kQueueFullPayload).has_value();
 }
 
+namespace {
+
+// The observer of a store without one.
+class IgnoringObserver final : public MapObserver {
+ public:
+  void BatchAnswered(const BatchAck&) override {}
+  void LogSynced(uint64_t, absl::Duration) override {}
+  void Checkpointed(uint64_t, absl::Duration) override {}
+  void Recovered(absl::Duration) override {}
+};
+
+std::shared_ptr<MapObserver> ObserverOf(const StoreOptions& options, const std::string& map) {
+  std::shared_ptr<MapObserver> observer = options.observer == nullptr ? nullptr : options.observer->ForMap(map);
+  return observer != nullptr ? observer : std::make_shared<IgnoringObserver>();
+}
+
+// The bytes of the records a checkpoint writes.
+uint64_t ImageBytes(const Shard::CheckpointImage& image) {
+  uint64_t bytes = image.touched.size() + image.dedup.size();
+  for (const auto* records : {&image.dynamic, &image.lossless, &image.wide, &image.labels, &image.statics}) {
+    for (const auto& [key, record] : *records) bytes += sizeof(key) + record.size();
+  }
+  return bytes;
+}
+
+}  // namespace
+
 MapStoreImpl::MapStoreImpl(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings)
-    : info_(std::move(info)), dir_(std::move(dir)), options_(options), settings_(std::move(settings)) {}
+    : info_(std::move(info)),
+      dir_(std::move(dir)),
+      options_(options),
+      observer_(ObserverOf(options_, info_.name)),
+      settings_(std::move(settings)) {}
 
 absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const MapInfo& info, const std::string& dir,
                                                          const StoreOptions& options) {
@@ -71,9 +103,11 @@ absl::StatusOr<std::unique_ptr<MapStoreImpl>> MapStoreImpl::Open(const MapInfo& 
     }
     store->shards_.push_back(*std::move(shard));
   }
+  const absl::Time recovery_start = absl::Now();
   if (absl::Status s = store->Recover(); !s.ok()) {
     return absl::Status(s.code(), absl::StrCat("map ", info.name, ": recovery: ", s.message()));
   }
+  store->observer_->Recovered(absl::Now() - recovery_start);
   // Only a report: an unreadable record is shown as none rather than keeping the map closed.
   if (auto last = ReadUpdateRecord(options.env, LastUpdatePath(dir)); last.ok()) store->last_update_ = *std::move(last);
   store->workers_ = std::make_unique<ShardWorkers>(info.shards, "fremen-shard");
@@ -353,6 +387,7 @@ void MapStoreImpl::CommitLoop() {
     // 1. Log the new batches and publications, then sync once for all of them (group commit).
     if (status.ok()) {
       base::MutexLock wal(&wal_mutex_);
+      const uint64_t before = wal_->last_lsn();
       LogGroup(stage.group);
       stage.group_lsn = wal_->last_lsn();
       for (Control& c : stage.controls) {
@@ -360,7 +395,10 @@ void MapStoreImpl::CommitLoop() {
         const char record[] = {kPublishRecord};
         c.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(record), 1});
       }
+      const absl::Time sync_start = absl::Now();
       status = wal_->Sync();
+      const uint64_t records = wal_->last_lsn() - before;
+      if (status.ok() && records > 0) observer_->LogSynced(records, absl::Now() - sync_start);
     }
     if (!status.ok()) {
       // Nothing of this stage is durable: answer it now. No checkpoint runs from now on (see
@@ -476,7 +514,10 @@ void MapStoreImpl::ApplyGroup(std::vector<Pending>& group) {
     applied_dedup_.Record(p->batch.writer_id, p->batch.sequence, p->fingerprint);
   }
   // Durable and visible: acknowledge.
-  for (Pending& p : group) p.done(p.ack);
+  for (Pending& p : group) {
+    observer_->BatchAnswered(p.ack);
+    p.done(p.ack);
+  }
 }
 
 void MapStoreImpl::IndexLabels(std::span<const StateLabel> labels) {
@@ -550,6 +591,7 @@ absl::Status MapStoreImpl::WriteCheckpoint(uint64_t lsn, std::vector<Shard::Chec
   // No backup copies the shards while they change, so that every copy is at one log position.
   base::MutexLock backup(&backup_mutex_);
   if (absl::Status error = WriteError(); !error.ok()) return error;  // latched meanwhile: see StartCheckpoint
+  const absl::Time start = absl::Now();
   std::vector<absl::Status> writes(shards_.size());
   ParallelForShards(shards_.size(), [&](size_t s) { writes[s] = shards_[s]->WriteCheckpoint(images[s]); });
   absl::Status status;
@@ -563,7 +605,13 @@ absl::Status MapStoreImpl::WriteCheckpoint(uint64_t lsn, std::vector<Shard::Chec
   // Reader slots of processes that died while reading (a backup tool, mdb_stat) would pin old
   // pages forever; clearing them with every checkpoint bounds the file's growth.
   for (const auto& shard : shards_) (void)shard->env().ClearStaleReaders();
-  if (!status.ok()) Latch(status);
+  if (!status.ok()) {
+    Latch(status);
+    return status;
+  }
+  uint64_t bytes = 0;
+  for (const Shard::CheckpointImage& image : images) bytes += ImageBytes(image);
+  observer_->Checkpointed(bytes, absl::Now() - start);
   return status;
 }
 
@@ -654,6 +702,15 @@ MapStats MapStoreImpl::Stats() const {
   {
     base::MutexLock lock(&last_update_mutex_);
     stats.last_update = last_update_;
+  }
+  {
+    base::MutexLock lock(&queue_mutex_);
+    stats.queued_observations = queued_observations_;
+  }
+  for (const auto& shard : shards_) {
+    stats.lmdb_map_size_bytes += shard->env().map_size();
+    stats.lmdb_growths += shard->env().growths();
+    stats.lmdb_readers += shard->env().readers();
   }
   return stats;
 }

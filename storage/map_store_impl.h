@@ -136,6 +136,8 @@ class MapStoreImpl final : public MapStore {
   const MapInfo info_;
   const std::string dir_;
   const StoreOptions options_;
+  // options_.observer's for this map, or one that ignores everything: never null.
+  const std::shared_ptr<MapObserver> observer_;
   std::unique_ptr<model::ModelSettings> settings_;
   std::vector<std::unique_ptr<Shard>> shards_;
   std::unique_ptr<ShardWorkers> workers_;

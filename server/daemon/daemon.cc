@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "server/http/health_routes.h"
+#include "server/metrics/metrics_route.h"
 #include "server/services/admin_service.h"
 #include "server/services/ingest_service.h"
 #include "server/rpc/logging.h"
@@ -66,7 +67,7 @@ Daemon::Daemon(ServerConfig config)
     : config_(std::move(config)),
       auth_(config_.tokens),
       blocking_("blocking", config_.blocking_threads, kMaxQueuedBlockingCalls),
-      deps_{&calls_, &auth_, &blocking_, &store_handle_} {}
+      deps_{&calls_, &auth_, &blocking_, &store_handle_, metrics_.calls()} {}
 
 Daemon::~Daemon() { (void)Stop(); }
 
@@ -190,10 +191,14 @@ void Daemon::AddHttpRoutes(httplib::Server& routes) {
     if (serving_) return "";
     return stopped_ ? "shutting down" : "recovering the maps";
   });
+  AddMetricsRoute(routes, &metrics_, &auth_);
 }
 
 absl::Status Daemon::PrepareUpdates() {
-  operations_ = std::make_unique<OperationRegistry>(StoreUpdateJob(&store_handle_), RealClock::Get());
+  OperationRegistry::Options jobs;
+  jobs.on_finished = [metrics = metrics_.jobs()](const OperationView& operation) { metrics->Finished(operation); };
+  operations_ = std::make_unique<OperationRegistry>(StoreUpdateJob(&store_handle_), RealClock::Get(), jobs);
+  metrics_.Watch(&store_handle_, operations_.get());
   auto scheduler = NewStoreUpdateScheduler(config_, RealClock::Get(), &store_handle_, operations_.get());
   if (!scheduler.ok()) return scheduler.status();
   scheduler_ = *std::move(scheduler);
@@ -217,6 +222,7 @@ absl::Status Daemon::OpenStore() {
   options.default_shards = config_.shards;
   options.checkpoint_log_bytes = config_.checkpoint_log_mb << 20;
   options.publication_waits_for_a_batch = config_.test_publication_waits_for_a_batch;
+  options.observer = metrics_.store();
   const auto store_log = NamedLogger(kStoreLogger);
   // What recovery repairs on its own (a torn log tail cut) is logged at warning.
   options.log_warning = [store_log](const std::string& line) { store_log->warn("{}", line); };

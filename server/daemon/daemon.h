@@ -28,6 +28,7 @@
 #include "server/http/http_server.h"
 #include "server/rpc/call_tracker.h"
 #include "server/jobs/operations.h"
+#include "server/metrics/metrics.h"
 #include "server/rpc/store_handle.h"
 #include "server/rpc/unary_call.h"
 #include "server/jobs/scrubber.h"
@@ -66,6 +67,7 @@ class Daemon {
   void SetServing(bool serving);
 
   ServerConfig config_;
+  Metrics metrics_;  // observed by the services, the store and the jobs: outlives them all
   CallTracker calls_;
   Authenticator auth_;
   BlockingPool blocking_;

@@ -231,6 +231,7 @@ void OperationRegistry::FinishLocked(Operation& op, absl::StatusOr<UpdateFigures
     } else {
       DaemonLog()->error("update of map {} failed after {} ({}): {}", view.map, Seconds(duration), view.name, view.message);
     }
+    if (options_.on_finished) options_.on_finished(view);
     return;
   }
   outcome->duration = duration;
@@ -242,6 +243,7 @@ void OperationRegistry::FinishLocked(Operation& op, absl::StatusOr<UpdateFigures
   view.result = *std::move(outcome);
   DaemonLog()->info("update of map {}: {} states in {}, ε_p {:.4g} → {:.4g}", view.map, view.result->states_published,
               Seconds(duration), view.result->prediction_error_before, view.result->prediction_error_after);
+  if (options_.on_finished) options_.on_finished(view);
 }
 
 void OperationRegistry::PruneLocked() {

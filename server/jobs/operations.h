@@ -107,6 +107,9 @@ class OperationRegistry {
     size_t max_finished = 256;
     absl::Duration keep_finished = absl::Hours(24);
     absl::Duration progress_log_interval = absl::Seconds(5);
+    // Called with each operation as it ends (done, failed or cancelled), under the registry's
+    // lock: it must be quick and must not call the registry (the metrics count it). Default: none.
+    std::function<void(const OperationView&)> on_finished;
   };
 
   struct Page {

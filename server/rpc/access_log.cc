@@ -8,9 +8,11 @@
 namespace fremen::server {
 
 void CallRecord::Finish(const grpc::Status& status, absl::string_view details) const {
+  const absl::Duration took = absl::Now() - start_;
+  if (observer_ != nullptr) observer_->CallFinished(method_, status.error_code(), took);
   static const std::shared_ptr<spdlog::logger> logger = spdlog::get(kAccessLogger);
   if (logger == nullptr) return;  // logging not set up (unit tests)
-  const double ms = absl::ToDoubleMilliseconds(absl::Now() - start_);
+  const double ms = absl::ToDoubleMilliseconds(took);
   const fmt::string_view method(method_.data(), method_.size());
   const std::string extra = details.empty() ? "" : absl::StrCat(" ", details);
   if (status.ok()) {

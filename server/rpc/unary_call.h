@@ -26,6 +26,7 @@
 #include "server/rpc/access_log.h"
 #include "server/rpc/auth.h"
 #include "server/rpc/blocking_pool.h"
+#include "server/rpc/call_observer.h"
 #include "server/rpc/call_tracker.h"
 #include "server/rpc/status_convert.h"
 #include "server/rpc/store_handle.h"
@@ -46,6 +47,7 @@ struct ServiceDeps {
   const Authenticator* auth = nullptr;
   BlockingPool* blocking = nullptr;
   const StoreHandle* store = nullptr;
+  CallObserver* observer = nullptr;  // the metrics; null: none
 };
 
 // One method: its name (in logs and errors), the access it needs, and whether its body may wait on
@@ -59,8 +61,8 @@ struct MethodSpec {
 // One unary call from its start to its one Finish.
 class UnaryCall {
  public:
-  UnaryCall(grpc::CallbackServerContext* context, const MethodSpec& method, CallTracker* calls)
-      : reactor_(context->DefaultReactor()), record_(method.name, *context), calls_(calls) {}
+  UnaryCall(grpc::CallbackServerContext* context, const MethodSpec& method, const ServiceDeps& deps)
+      : reactor_(context->DefaultReactor()), record_(method.name, *context, deps.observer), calls_(deps.calls) {}
 
   grpc::ServerUnaryReactor* reactor() const { return reactor_; }
   // Logs the call, hands its status to gRPC and, when `counted`, ends it in the tracker.
@@ -81,7 +83,7 @@ class UnaryCall {
 template <typename Body>
 grpc::ServerUnaryReactor* ServeUnary(const ServiceDeps& deps, grpc::CallbackServerContext* context,
                                      const MethodSpec& method, Body body) {
-  const UnaryCall call(context, method, deps.calls);
+  const UnaryCall call(context, method, deps);
   if (absl::Status refused = deps.calls->Begin(); !refused.ok()) {
     call.Finish(refused, /*counted=*/false);
     return call.reactor();

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "server/convert/ingest_convert.h"
 #include "server/rpc/map_lookup.h"
 #include "server/rpc/map_name.h"
@@ -37,7 +38,7 @@ bool IsBatchError(const absl::Status& status) {
 }  // namespace
 
 IngestStream::IngestStream(const ServiceDeps& deps, grpc::CallbackServerContext* context)
-    : deps_(deps), context_(context), record_(kIngest.name, *context) {}
+    : deps_(deps), context_(context), record_(kIngest.name, *context, deps.observer) {}
 
 IngestStream* IngestStream::Start(const ServiceDeps& deps, grpc::CallbackServerContext* context) {
   std::shared_ptr<IngestStream> stream(new IngestStream(deps, context));
@@ -71,8 +72,10 @@ void IngestStream::OnReadDone(bool ok) {
   }
   // An unparsable message ends the stream: the batches after it cannot be trusted to be what the
   // client sent either. Then the map is routed.
+  const size_t bytes = message_.Length();  // before Parse consumes it
   absl::Status routed = Parse();
   if (routed.ok()) routed = Route();
+  if (routed.ok() && deps_.observer != nullptr) deps_.observer->IngestReceived(map_name_, bytes);
   if (!routed.ok()) {
     base::MutexLock lock(&mutex_);
     holding_ = false;
@@ -130,6 +133,7 @@ void IngestStream::SubmitHeld() {
     holding_ = false;
   } else if (storage::IsQueueFull(status) && !EndingLocked()) {
     waiting_room_ = true;
+    waiting_since_ = absl::Now();
     lock.Release();
     WaitForRoom(observations);
   } else if (IsBatchError(status)) {
@@ -160,6 +164,7 @@ void IngestStream::RoomAvailable() {
     base::MutexLock lock(&mutex_);
     if (!waiting_room_) return;  // dropped by WindDown
     waiting_room_ = false;
+    if (deps_.observer != nullptr) deps_.observer->IngestWaited(map_name_, absl::Now() - waiting_since_);
     if (EndingLocked()) {
       slots_.pop_back();
       holding_ = false;

@@ -125,6 +125,7 @@ class IngestStream final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
   bool reading_ ABSL_GUARDED_BY(mutex_) = false;       // a StartRead is outstanding
   bool holding_ ABSL_GUARDED_BY(mutex_) = false;       // request_ holds a batch not yet in the store
   bool waiting_room_ ABSL_GUARDED_BY(mutex_) = false;  // ... because the store's queue is full
+  absl::Time waiting_since_ ABSL_GUARDED_BY(mutex_);    // ... from then (for the metrics)
   bool writing_ ABSL_GUARDED_BY(mutex_) = false;       // a StartWrite is outstanding (of slots_.front())
   bool cancelled_ ABSL_GUARDED_BY(mutex_) = false;
   bool finished_ ABSL_GUARDED_BY(mutex_) = false;

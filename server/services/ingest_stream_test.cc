@@ -2,9 +2,9 @@
 // keeps running into a full queue (Submit: ResourceExhausted), so these tests exercise the
 // backpressure path — hold the batch, stop reading, resubmit from MapStore::OnRoom — which the
 // end-to-end tests (tests/ingest_service_test.cc) rarely reach with the daemon's 16M-observation
-// queue. Also: draining winds an idle stream down at once, and a map whose log fails (a full disk,
-// injected) ends its streams at once with the storage error instead of holding them as if the
-// queue were full.
+// queue; the metrics see every message's bytes, every stream's end and the waits. Also: draining
+// winds an idle stream down at once, and a map whose log fails (a full disk, injected) ends its
+// streams at once with the storage error instead of holding them as if the queue were full.
 #include "server/services/ingest_stream.h"
 
 #include <grpcpp/grpcpp.h>
@@ -13,6 +13,8 @@
 #include <atomic>
 #include <thread>
 
+#include "server/metrics/call_metrics.h"
+#include "server/metrics/sample_lookup.h"
 #include "server/services/ingest_service.h"
 #include "storage/env/fault_injection_env.h"
 #include "storage/store.h"
@@ -84,7 +86,9 @@ class IngestStreamTest : public ::testing::Test {
   Authenticator auth_{{}};
   BlockingPool blocking_{"test", 1, 16};
   StoreHandle handle_;
-  ServiceDeps deps_{&calls_, &auth_, &blocking_, &handle_};
+  prometheus::Registry registry_;
+  CallMetrics metrics_{registry_};  // what the streams tell the metrics
+  ServiceDeps deps_{&calls_, &auth_, &blocking_, &handle_, &metrics_};
   std::unique_ptr<IngestServiceImpl> service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<v1::IngestService::Stub> stub_;
@@ -130,6 +134,16 @@ TEST_F(IngestStreamTest, StreamsWaitForRoomInTheStoreAndLoseNothing) {
     stream->WritesDone();
     EXPECT_TRUE(stream->Finish().ok());
   }
+  // The metrics saw every message's bytes, every stream's end, and the waits for room.
+  double bytes = 0;
+  for (uint64_t writer = 1; writer <= kStreams; ++writer) {
+    for (uint64_t i = 0; i < kBatches; ++i) bytes += static_cast<double>(Batch(writer, i).ByteSizeLong());
+    bytes += static_cast<double>(Batch(writer, kBatches - 1).ByteSizeLong());  // the resend
+  }
+  const auto families = registry_.Collect();
+  EXPECT_EQ(Sample(families, "fremen_ingest_received_bytes_total", {{"map", "lab"}}), bytes);
+  EXPECT_EQ(Sample(families, "fremen_grpc_calls_total", {{"method", "Ingest"}, {"code", "OK"}}), 2 * kStreams);
+  EXPECT_GT(Sample(families, "fremen_ingest_backpressure_wait_seconds_total", {{"map", "lab"}}).value_or(0), 0);
 }
 
 TEST_F(IngestStreamTest, DrainEndsAnIdleStreamAtOnceWithUnavailable) {

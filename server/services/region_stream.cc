@@ -25,7 +25,7 @@ constexpr uint64_t kInlineCells = 1 << 15;
 }  // namespace
 
 RegionStream::RegionStream(const ServiceDeps& deps, grpc::CallbackServerContext* context)
-    : deps_(deps), context_(context), record_(kPredictRegion.name, *context) {}
+    : deps_(deps), context_(context), record_(kPredictRegion.name, *context, deps.observer) {}
 
 RegionStream* RegionStream::Start(const ServiceDeps& deps, grpc::CallbackServerContext* context,
                                   const v1::PredictRegionRequest& request) {

@@ -240,7 +240,14 @@ absl::Status LmdbEnv::Grow() {
   const int rc = mdb_env_set_mapsize(env_, bigger);
   if (rc != MDB_SUCCESS) return LmdbStatus(rc, "mdb_env_set_mapsize");
   map_size_ = bigger;
+  growths_.fetch_add(1, std::memory_order_relaxed);
   return absl::OkStatus();
+}
+
+uint64_t LmdbEnv::readers() const {
+  MDB_envinfo info;
+  if (mdb_env_info(env_, &info) != MDB_SUCCESS) return 0;
+  return info.me_numreaders;
 }
 
 absl::Status LmdbEnv::Write(const std::function<absl::Status(LmdbTxn&)>& f) {

@@ -151,6 +151,11 @@ class LmdbEnv {
     absl::ReaderMutexLock lock(&resize_);
     return map_size_;
   }
+  // Times Write grew the map since Open (for metrics).
+  uint64_t growths() const { return growths_.load(std::memory_order_relaxed); }
+  // Reader slots in use, by any process (mdb_env_info's me_numreaders: slots ever taken and not
+  // yet cleared, so an upper bound of the readers active now).
+  uint64_t readers() const;
   // Bytes of the data file in use (pages up to the last one written).
   absl::StatusOr<size_t> UsedBytes() const;
   const std::string& dir() const { return dir_; }
@@ -183,6 +188,7 @@ class LmdbEnv {
   size_t map_size_ ABSL_GUARDED_BY(resize_);
   base::Mutex writer_;  // guards no member: one write transaction at a time
   std::atomic<uint64_t> commits_started_ = 0, commits_ended_ = 0;  // of Commit
+  std::atomic<uint64_t> growths_ = 0;
   // Read transactions (and the write transaction) shared, map growth exclusive. absl::Mutex, not
   // std::shared_mutex (nor base::SharedMutex, which is one): glibc's rwlock prefers readers, so a
   // steady stream of reads starved Grow (and the writer behind it) indefinitely; absl::Mutex makes

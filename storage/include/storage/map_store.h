@@ -43,6 +43,7 @@
 #include "storage/model/model_settings.h"
 #include "storage/queries.h"
 #include "storage/shard_stats.h"
+#include "storage/store_observer.h"
 #include "storage/update_record.h"
 #include "storage/verify.h"
 
@@ -78,6 +79,9 @@ struct StoreOptions {
   // acknowledged, so that a test sees batches acknowledged while a publication runs however long
   // a slice takes against a log sync. Default: false.
   bool publication_waits_for_a_batch = false;
+  // Told of every map's batches, log syncs, checkpoints and recovery (storage/store_observer.h),
+  // for metrics. REQUIRES: outlives the stores. Default: none.
+  StoreObserver* observer = nullptr;
 };
 
 // Whether `status` is Submit's refusal for a full queue — backpressure: resubmit once OnRoom calls
@@ -96,6 +100,13 @@ struct MapStats {
   // Lossless maps: ε_e and ε_p over all observed slots of all states (eq. 15).
   double estimation_error = 0;
   double lossless_prediction_error = 0;
+  // Observations submitted but not yet taken by the committer (the queue Submit bounds).
+  uint64_t queued_observations = 0;
+  // The shards' LMDB environments: their map sizes summed, the times a write grew one (since the
+  // map opened), and the reader slots in use (this process and others, such as a verifier).
+  uint64_t lmdb_map_size_bytes = 0;
+  uint64_t lmdb_growths = 0;
+  uint64_t lmdb_readers = 0;
   // What the last update job did, kept across restarts (RecordUpdate); nullopt before the first.
   std::optional<UpdateRecord> last_update;
 };
