@@ -4,29 +4,21 @@
 
 #include <string>
 
-#include "absl/strings/numbers.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/fremend_fixture.h"
+#include "tests/http_client.h"
 
 namespace fremen::testing {
 namespace {
 
 using ::testing::HasSubstr;
 
-// "HOST:PORT" → the client's host and port.
-httplib::Client ClientFor(const std::string& address) {
-  const size_t colon = address.rfind(':');
-  int port = 0;
-  EXPECT_TRUE(absl::SimpleAtoi(address.substr(colon + 1), &port)) << address;
-  return httplib::Client(address.substr(0, colon), port);
-}
-
 class HttpHealthTest : public DaemonTest {};
 
 TEST_F(HttpHealthTest, LivenessAndReadinessAnswerOnceServing) {
   ASSERT_FALSE(daemon_->http_address().empty()) << daemon_->Log();
-  httplib::Client client = ClientFor(daemon_->http_address());
+  httplib::Client client = HttpClientFor(daemon_->http_address());
   const httplib::Result healthz = client.Get("/healthz");
   ASSERT_TRUE(healthz) << httplib::to_string(healthz.error());
   EXPECT_EQ(healthz->status, 200);
@@ -63,18 +55,15 @@ TEST(HttpTlsTest, TheHttpPortServesTlsWithTheDaemonsCertificate) {
       grpc::SslCredentials(options));
   ASSERT_TRUE(started.ok()) << started.status();
   const std::string address = (*started)->http_address();
-  const size_t colon = address.rfind(':');
-  int port = 0;
-  ASSERT_TRUE(absl::SimpleAtoi(address.substr(colon + 1), &port));
-
-  httplib::SSLClient secure(address.substr(0, colon), port);
+  const HostPort split = SplitHostPort(address);
+  httplib::SSLClient secure(split.host, split.port);
   secure.set_ca_cert_path(certificate->cert_path.c_str());
   secure.enable_server_certificate_verification(true);
   const httplib::Result over_tls = secure.Get("/healthz");
   ASSERT_TRUE(over_tls) << httplib::to_string(over_tls.error());
   EXPECT_EQ(over_tls->status, 200);
 
-  httplib::Client plain = ClientFor(address);
+  httplib::Client plain = HttpClientFor(address);
   EXPECT_FALSE(plain.Get("/healthz")) << "plain HTTP must not be answered on a TLS port";
   EXPECT_EQ((*started)->Stop(), 0);
 }

@@ -1,4 +1,4 @@
-// What the metrics' end-to-end tests share: an HTTP client for a daemon's HTTP port, and a map
+// What the metrics' end-to-end tests share: an HTTP client for a daemon's HTTP port (tests/http_client.h), and a map
 // created and fed through the daemon's gRPC services (so that every count comes from real calls).
 #pragma once
 
@@ -8,24 +8,16 @@
 #include <utility>
 #include <vector>
 
-#include "absl/strings/numbers.h"
 #include "fremen/v1/ingest.grpc.pb.h"
 #include "fremen/v1/maps.grpc.pb.h"
 #include "gtest/gtest.h"
 #include "tests/fremend_fixture.h"
+#include "tests/http_client.h"
 #include "tests/map_specs.h"
 
 namespace fremen::testing {
 
 using Metadata = std::vector<std::pair<std::string, std::string>>;
-
-// "HOST:PORT" → a client of that host and port.
-inline httplib::Client HttpClientFor(const std::string& address) {
-  const size_t colon = address.rfind(':');
-  int port = 0;
-  EXPECT_TRUE(absl::SimpleAtoi(address.substr(colon + 1), &port)) << address;
-  return httplib::Client(address.substr(0, colon), port);
-}
 
 // Creates the 20x10 grid map `name` over gRPC.
 inline void CreateGridMap(FremendProcess& daemon, const std::string& name, const Metadata& metadata = {}) {
