@@ -654,6 +654,39 @@ std::vector<uint8_t> MapStoreImpl::Observed(std::span<const uint64_t> keys) cons
   return out;
 }
 
+absl::StatusOr<std::vector<StateLabel>> MapStoreImpl::Labels(const std::string& group) const {
+  std::vector<StateLabel> labels;
+  if (group.empty()) {
+    for (const auto& shard : shards_) {
+      shard->ForEachLabel([&](uint64_t key, const std::string& name, const std::string& its_group) {
+        labels.push_back(StateLabel{key, name, its_group});
+      });
+    }
+  } else {
+    std::vector<uint64_t> members;
+    {
+      base::MutexLock lock(&groups_mutex_);
+      auto it = groups_.find(group);
+      if (it == groups_.end()) {
+        return absl::NotFoundError(absl::StrCat("map ", info_.name, " has no group \"", group, "\""));
+      }
+      members = it->second;
+    }
+    labels.reserve(members.size());
+    for (uint64_t key : members) {
+      // A member's label can only have been replaced by a later batch naming it again; its group
+      // then still says whether it belongs here.
+      if (auto label = Label(key); label && label->second == group) {
+        labels.push_back(StateLabel{key, label->first, label->second});
+      }
+    }
+  }
+  std::sort(labels.begin(), labels.end(), [](const StateLabel& a, const StateLabel& b) {
+    return a.name != b.name ? a.name < b.name : a.key < b.key;
+  });
+  return labels;
+}
+
 absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStoreImpl::TopN(const std::string& group, double t, size_t n,
                                                                       const PredictOptions& options) const {
   std::vector<uint64_t> members;

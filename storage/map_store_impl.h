@@ -54,6 +54,8 @@ class MapStoreImpl final : public MapStore {
   std::optional<std::pair<std::string, std::string>> Label(uint64_t key) const override {
     return ShardFor(key).Label(key);
   }
+  absl::StatusOr<std::vector<StateLabel>> Labels(const std::string& group) const override
+      ABSL_LOCKS_EXCLUDED(groups_mutex_);
   absl::StatusOr<std::vector<std::pair<uint64_t, float>>> TopN(const std::string& group, double t, size_t n,
                                                                const PredictOptions& options) const override
       ABSL_LOCKS_EXCLUDED(groups_mutex_);

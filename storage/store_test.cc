@@ -160,6 +160,17 @@ TEST(StoreTest, GenericMapsKeepLabelsAndAnswerTopN) {
   EXPECT_EQ(all->back().first, kitchen_door);
   EXPECT_NEAR(all->back().second, 0.5, 0.01);
   EXPECT_TRUE(absl::IsNotFound(map->TopN("garage", 0, 1, {}).status()));
+  // The labels, listed by name, all or a group's, came back from disk too.
+  auto labels = map->Labels("");
+  ASSERT_TRUE(labels.ok()) << labels.status();
+  ASSERT_EQ(labels->size(), 6u);
+  EXPECT_EQ((*labels)[0], (StateLabel{1000003, "door1", "kitchen"}));
+  EXPECT_EQ((*labels)[5], (StateLabel{6 * 1000003, "door6", "hall"}));
+  auto hall = map->Labels("hall");
+  ASSERT_TRUE(hall.ok());
+  ASSERT_EQ(hall->size(), 3u);
+  EXPECT_EQ(hall->front().name, "door4");
+  EXPECT_TRUE(absl::IsNotFound(map->Labels("garage").status()));
   const auto snapshot = map->Snapshot(kitchen_door);
   ASSERT_TRUE(snapshot.has_value());
   EXPECT_EQ(snapshot->name, "door3");

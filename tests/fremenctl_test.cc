@@ -205,6 +205,31 @@ TEST_F(FremenctlTest, TopRanksTheGroup) {
   EXPECT_THAT(group.err, HasSubstr("no group \"windows\""));
 }
 
+TEST_F(FremenctlTest, StatesListsTheNamedStatesByName) {
+  ASSERT_EQ(Run({"maps", "create", "doors", "--generic"}).exit_code, 0);
+  auto session = client_->OpenIngest("doors");
+  ASSERT_TRUE(session.ok());
+  ScanBuilder scan(kStart);
+  scan.AddState(1, 1, "front", "entrances").AddState(2, 0, "back", "entrances").AddState(3, 1, "kitchen-light", "lights");
+  ASSERT_TRUE((*session)->Send(*scan.Build()).ok());
+  ASSERT_TRUE((*session)->Close(absl::Seconds(30)).ok());
+  RunResult all = Run({"states", "--map", "doors"});
+  ASSERT_EQ(all.exit_code, 0) << all.err;
+  const size_t back = all.out.find("back"), front = all.out.find("front"), light = all.out.find("kitchen-light");
+  ASSERT_NE(back, std::string::npos) << all.out;
+  ASSERT_NE(front, std::string::npos) << all.out;
+  ASSERT_NE(light, std::string::npos) << all.out;
+  EXPECT_LT(back, front);  // by name
+  EXPECT_LT(front, light);
+  RunResult lights = Run({"states", "--map", "doors", "--group", "lights"});
+  ASSERT_EQ(lights.exit_code, 0) << lights.err;
+  EXPECT_THAT(lights.out, HasSubstr("kitchen-light"));
+  EXPECT_THAT(lights.out, Not(HasSubstr("front")));
+  RunResult missing = Run({"states", "--map", "doors", "--group", "windows"});
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_THAT(missing.err, HasSubstr("no group \"windows\""));
+}
+
 TEST_F(FremenctlTest, AnomaliesFlagsWhatContradictsThePattern) {
   CreateGrid("lab");
   IngestTwoWeeks("lab");

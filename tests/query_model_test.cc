@@ -1,9 +1,10 @@
-// End-to-end tests of QueryService's other reads against the real fremend: TopStates,
+// End-to-end tests of QueryService's other reads against the real fremend: TopStates, ListStates,
 // CheckAnomalies, GetStateModel, Reconstruct and GetMapStats — answers equal to the store's, and the
 // bad-input rows that apply, each with its exact status code and the field named.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -76,6 +77,75 @@ TEST_F(QueryServiceTest, TopStatesBadInput) {
   bad = r;
   bad.set_map("lab");
   EXPECT_STATUS(call(bad), FAILED_PRECONDITION, "is a grid");
+}
+
+// --- ListStates ---
+
+TEST_F(QueryServiceTest, ListStatesWalksTheNamedStatesByName) {
+  CreateAndFillMaps();
+  ASSERT_FALSE(HasFatalFailure());
+  std::vector<std::string> names;
+  for (int i = 0; i < kDoors; ++i) names.push_back(DoorName(i));
+  std::sort(names.begin(), names.end());
+  v1::ListStatesRequest request;
+  request.set_map("doors");
+  request.set_page_size(3);
+  std::vector<v1::NamedState> listed;
+  int pages = 0;
+  do {
+    v1::ListStatesResponse response;
+    ASSERT_TRUE(query_->ListStates(CallContext().get(), request, &response).ok());
+    EXPECT_EQ(response.total(), static_cast<uint64_t>(kDoors));
+    listed.insert(listed.end(), response.states().begin(), response.states().end());
+    request.set_page_token(response.next_page_token());
+    ++pages;
+  } while (!request.page_token().empty() && pages < 100);
+  EXPECT_EQ(pages, (kDoors + 2) / 3);
+  ASSERT_EQ(listed.size(), names.size());
+  for (size_t i = 0; i < names.size(); ++i) {
+    EXPECT_EQ(listed[i].name(), names[i]);
+    EXPECT_EQ(listed[i].id(), storage::StateIdOfName(names[i]));
+    const int door = std::stoi(names[i].substr(5));
+    EXPECT_EQ(listed[i].group(), door < 5 ? "kitchen" : "hall") << names[i];
+  }
+
+  v1::ListStatesRequest hall;
+  hall.set_map("doors");
+  hall.set_group("hall");
+  v1::ListStatesResponse response;
+  ASSERT_TRUE(query_->ListStates(CallContext().get(), hall, &response).ok());
+  EXPECT_EQ(response.states_size(), kDoors - 5);
+  EXPECT_EQ(response.total(), static_cast<uint64_t>(kDoors - 5));
+  EXPECT_TRUE(response.next_page_token().empty());
+  for (const v1::NamedState& state : response.states()) EXPECT_EQ(state.group(), "hall") << state.name();
+}
+
+TEST_F(QueryServiceTest, ListStatesBadInput) {
+  CreateMap(GridMap("lab", kNx, kNy));
+  CreateMap(GenericMap("doors"));
+  v1::ListStatesResponse response;
+  const auto call = [&](const v1::ListStatesRequest& request) {
+    return query_->ListStates(CallContext().get(), request, &response);
+  };
+  v1::ListStatesRequest r;
+  r.set_map("doors");
+  ASSERT_TRUE(call(r).ok());  // a map no batch has named states in: an empty list
+  EXPECT_EQ(response.states_size(), 0);
+  EXPECT_EQ(response.total(), 0u);
+  v1::ListStatesRequest bad = r;
+  bad.set_group("kitchen");
+  EXPECT_STATUS(call(bad), NOT_FOUND, "kitchen");
+  bad = r;
+  bad.set_page_size(-1);
+  EXPECT_STATUS(call(bad), INVALID_ARGUMENT, "page_size");
+  bad = r;
+  bad.set_page_token("no such token");
+  EXPECT_STATUS(call(bad), INVALID_ARGUMENT, "page_token");
+  bad = r;
+  bad.set_map("lab");
+  EXPECT_STATUS(call(bad), FAILED_PRECONDITION, "is a grid");
+  bad.set_map("nowhere");
+  EXPECT_STATUS(call(bad), NOT_FOUND, "nowhere");
 }
 
 // --- CheckAnomalies ---

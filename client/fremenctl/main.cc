@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   fremen::client::RegisterMapsCommand(app);
   fremen::client::RegisterPredictCommand(app);
   fremen::client::RegisterTopCommand(app);
+  fremen::client::RegisterStatesCommand(app);
   fremen::client::RegisterAnomaliesCommand(app);
   fremen::client::RegisterStatsCommand(app);
   fremen::client::RegisterUpdateCommand(app);

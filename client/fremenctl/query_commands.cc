@@ -122,6 +122,26 @@ void RegisterTopCommand(CLI::App& app) {
   });
 }
 
+void RegisterStatesCommand(CLI::App& app) {
+  struct Args {
+    std::string map, group;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* states = app.add_subcommand("states", "The named states of a generic map (or of one group), by name");
+  states->add_option("--map", a->map, "the map")->required();
+  states->add_option("--group", a->group, "only this group's states");
+  states->callback([a] {
+    Client client = ConnectOrExit("states");
+    auto listed = client.ListAllStates(a->map, a->group, GlobalCall());
+    if (!listed.ok()) FailCall("states", absl::StrCat("map ", a->map), listed.status(), a->map);
+    std::printf("%-20s  %-24s  %s\n", "ID", "NAME", "GROUP");
+    for (const v1::NamedState& s : *listed) {
+      std::printf("%-20llu  %-24s  %s\n", static_cast<unsigned long long>(s.id()),
+                  s.name().empty() ? "-" : s.name().c_str(), s.group().empty() ? "-" : s.group().c_str());
+    }
+  });
+}
+
 void RegisterAnomaliesCommand(CLI::App& app) {
   struct Args {
     std::string map;

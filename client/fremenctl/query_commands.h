@@ -7,6 +7,7 @@ namespace fremen::client {
 
 void RegisterPredictCommand(CLI::App& app);
 void RegisterTopCommand(CLI::App& app);
+void RegisterStatesCommand(CLI::App& app);
 void RegisterAnomaliesCommand(CLI::App& app);
 void RegisterStatsCommand(CLI::App& app);
 

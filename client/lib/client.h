@@ -140,6 +140,9 @@ class Client {
   absl::StatusOr<std::vector<v1::ScoredState>> TopStates(absl::string_view map, absl::string_view group, double time,
                                                          uint32_t n, const ModelOptions& model = {},
                                                          const CallOptions& call = {}) const;
+  // Every named state of a generic map (or of one `group`), in name order: all pages of ListStates.
+  absl::StatusOr<std::vector<v1::NamedState>> ListAllStates(absl::string_view map, absl::string_view group = "",
+                                                            const CallOptions& call = {}) const;
   // Which observations (value of each state at its time, or all at times[0]) are anomalous at
   // `confidence` (in [0.5, 1]).
   absl::StatusOr<std::vector<Anomaly>> CheckAnomalies(absl::string_view map, const StateSet& states,

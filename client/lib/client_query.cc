@@ -97,6 +97,26 @@ absl::StatusOr<std::vector<v1::ScoredState>> Client::TopStates(absl::string_view
   return std::vector<v1::ScoredState>(response.states().begin(), response.states().end());
 }
 
+absl::StatusOr<std::vector<v1::NamedState>> Client::ListAllStates(absl::string_view map, absl::string_view group,
+                                                                  const CallOptions& call) const {
+  v1::ListStatesRequest request;
+  request.set_map(std::string(map));
+  request.set_group(std::string(group));
+  request.set_page_size(1000);
+  std::vector<v1::NamedState> states;
+  do {
+    v1::ListStatesResponse response;
+    absl::Status status = connection_->CallIdempotent(call, map, [&](grpc::ClientContext& context) {
+      return connection_->query().ListStates(&context, request, &response);
+    });
+    if (!status.ok()) return status;
+    states.insert(states.end(), std::make_move_iterator(response.mutable_states()->begin()),
+                  std::make_move_iterator(response.mutable_states()->end()));
+    request.set_page_token(response.next_page_token());
+  } while (!request.page_token().empty());
+  return states;
+}
+
 absl::StatusOr<std::vector<Anomaly>> Client::CheckAnomalies(absl::string_view map, const StateSet& states,
                                                             const std::vector<float>& values,
                                                             const std::vector<double>& times, float confidence,

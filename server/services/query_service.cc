@@ -9,6 +9,7 @@
 #include "server/convert/query_args.h"
 #include "server/convert/query_convert.h"
 #include "server/services/region_stream.h"
+#include "server/services/state_page.h"
 #include "server/convert/state_refs.h"
 #include "storage/model/lossless/lossless_history.h"
 #include "storage/model/published_model.h"
@@ -29,6 +30,7 @@ constexpr MethodSpec kCheckAnomaliesLarge{"CheckAnomalies", Access::kRead, /*blo
 constexpr MethodSpec kGetStateModel{"GetStateModel", Access::kRead, /*blocking=*/true};
 constexpr MethodSpec kReconstruct{"Reconstruct", Access::kRead, /*blocking=*/true};
 constexpr MethodSpec kGetMapStats{"GetMapStats", Access::kRead, /*blocking=*/true};
+constexpr MethodSpec kListStates{"ListStates", Access::kRead, /*blocking=*/true};
 
 // Up to this many predictions a call is answered inline (tens of microseconds); more go to the pool.
 constexpr uint64_t kInlinePredictions = 4096;
@@ -215,6 +217,30 @@ absl::Status DoGetMapStats(const StoreHandle& store, const grpc::ServerContextBa
   return absl::OkStatus();
 }
 
+absl::Status DoListStates(const StoreHandle& store, const grpc::ServerContextBase& context,
+                          const v1::ListStatesRequest& request, v1::ListStatesResponse& response) {
+  auto map = LookUpMap(store, context, request.map());
+  if (!map.ok()) return map.status();
+  const MapInfo& info = (*map)->info();
+  if (info.kind != storage::MapKind::kGeneric) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("map ", info.name, " is a grid: its states are cells, not named states (ListStates lists a generic map's)"));
+  }
+  auto labels = (*map)->Labels(request.group());
+  if (!labels.ok()) return labels.status();
+  auto page = PageOfStates(*labels, request.page_size(), request.page_token());
+  if (!page.ok()) return page.status();
+  for (const storage::StateLabel& label : page->states) {
+    v1::NamedState& state = *response.add_states();
+    state.set_id(label.key);
+    state.set_name(label.name);
+    state.set_group(label.group);
+  }
+  response.set_next_page_token(page->next_page_token);
+  response.set_total(labels->size());
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 grpc::ServerUnaryReactor* QueryServiceImpl::Predict(grpc::CallbackServerContext* context,
@@ -268,6 +294,14 @@ grpc::ServerUnaryReactor* QueryServiceImpl::GetMapStats(grpc::CallbackServerCont
                                                         v1::GetMapStatsResponse* response) {
   return ServeUnary(deps_, context, kGetMapStats, [this, context, request, response] {
     return DoGetMapStats(*deps_.store, *context, *request, *response);
+  });
+}
+
+grpc::ServerUnaryReactor* QueryServiceImpl::ListStates(grpc::CallbackServerContext* context,
+                                                       const v1::ListStatesRequest* request,
+                                                       v1::ListStatesResponse* response) {
+  return ServeUnary(deps_, context, kListStates, [this, context, request, response] {
+    return DoListStates(*deps_.store, *context, *request, *response);
   });
 }
 

@@ -5,7 +5,7 @@
 //
 // Small predictions run inline on the gRPC thread (a single-state Predict is a few microseconds of
 // work; the hop to a pool would cost more); large ones, and the methods whose cost grows with the
-// map or a state's history (TopStates, GetStateModel, Reconstruct, GetMapStats), run on the
+// map or a state's history (TopStates, GetStateModel, Reconstruct, GetMapStats, ListStates), run on the
 // blocking pool so that they cannot hold up the gRPC threads. PredictRegion streams
 // (server/services/region_stream.h).
 // Thread-safety: gRPC calls the handlers from any thread; the service holds no state of its own.
@@ -36,6 +36,8 @@ class QueryServiceImpl final : public v1::QueryService::CallbackService {
                                         v1::ReconstructResponse* response) override;
   grpc::ServerUnaryReactor* GetMapStats(grpc::CallbackServerContext* context, const v1::GetMapStatsRequest* request,
                                         v1::GetMapStatsResponse* response) override;
+  grpc::ServerUnaryReactor* ListStates(grpc::CallbackServerContext* context, const v1::ListStatesRequest* request,
+                                       v1::ListStatesResponse* response) override;
 
  private:
   const ServiceDeps deps_;

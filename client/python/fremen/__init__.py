@@ -17,7 +17,8 @@ client/python/README.md.
 
 from fremen._version import __version__
 from fremen.arrays import Array, FlatArray
-from fremen.client import DEFAULT_ADDRESS, AnomalyCheck, Client, Prediction, Reconstruction, ScoredState, connect
+from fremen.client import (DEFAULT_ADDRESS, AnomalyCheck, Client, NamedState, Prediction, Reconstruction, ScoredState,
+                           connect)
 from fremen.errors import (AlreadyExists, DeadlineExceeded, Error, FailedPrecondition, InvalidArgument, NotFound,
                            OutOfRange, PermissionDenied, ResourceExhausted, Unauthenticated, Unavailable)
 from fremen.ingest import Ack, Batch, IngestSession, Rejection
@@ -28,10 +29,10 @@ from fremen.retry import Backoff
 from fremen.status import Backup, CheckProblem, MapScrub, ServerStatus
 
 __all__ = [
-    "DEFAULT_ADDRESS", "Ack", "AlreadyExists", "AnomalyCheck", "Array", "Backoff", "Backup", "Batch", "CheckProblem",
-    "Client", "Component", "DeadlineExceeded", "Error", "FailedPrecondition", "FlatArray", "IngestSession",
-    "InvalidArgument", "MapInfo", "MapScrub", "MapStats", "MapUpdate", "NotFound", "Operation", "OrderError",
-    "OutOfRange", "PermissionDenied", "Persistence", "Prediction", "Progress", "Reconstruction", "Rejection",
-    "ResourceExhausted", "ScoredState", "ServerStatus", "StateModel", "Unauthenticated", "Unavailable",
-    "UpdateResult", "__version__", "connect",
+    "DEFAULT_ADDRESS", "Ack", "AlreadyExists", "AnomalyCheck", "Array", "Backoff", "Backup", "Batch",
+    "CheckProblem", "Client", "Component", "DeadlineExceeded", "Error", "FailedPrecondition", "FlatArray",
+    "IngestSession", "InvalidArgument", "MapInfo", "MapScrub", "MapStats", "MapUpdate", "NamedState", "NotFound",
+    "Operation", "OrderError", "OutOfRange", "PermissionDenied", "Persistence", "Prediction", "Progress",
+    "Reconstruction", "Rejection", "ResourceExhausted", "ScoredState", "ServerStatus", "StateModel",
+    "Unauthenticated", "Unavailable", "UpdateResult", "__version__", "connect",
 ]

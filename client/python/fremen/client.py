@@ -95,6 +95,13 @@ class ScoredState:
 
 
 @dataclasses.dataclass(frozen=True)
+class NamedState:
+    id: int
+    name: str
+    group: str
+
+
+@dataclasses.dataclass(frozen=True)
 class AnomalyCheck:
     """One element per observation checked."""
     probabilities: list[float]
@@ -391,6 +398,12 @@ class Client(AdminCalls):
                                              options=refs.prediction_options(persistence, order))
         response = self._call(self._query.TopStates, request, map_name)
         return [ScoredState(s.id, s.name, s.probability) for s in response.states]
+
+    def list_states(self, map_name: str, group: str = "", page_size: int = 0) -> Iterator[NamedState]:
+        """The named states of a generic map (or of one `group`) in name order, a page at a time."""
+        request = query_pb2.ListStatesRequest(map=map_name, group=group, page_size=page_size)
+        for s in self._pages(self._query.ListStates, request, "states", map_name):
+            yield NamedState(s.id, s.name, s.group)
 
     def anomalies(self, map_name: str, values: Sequence[float], times: Times, confidence: float, *,
                   ids: Optional[Ids] = None, names: Optional[Names] = None, cells: Optional[Cells] = None,

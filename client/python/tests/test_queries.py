@@ -235,6 +235,16 @@ class QueriesTest(DaemonTestCase):
         with self.assertRaises(fremen.NotFound):
             self.client.top("doors", "no-such-group", NIGHT)
 
+    def test_list_states_by_name(self):
+        self.fill_doors()
+        states = list(self.client.list_states("doors", page_size=1))  # one state a page: the pages join
+        self.assertEqual([s.name for s in states], sorted(s.name for s in states))
+        self.assertEqual({s.name for s in states}, {"always", "door"})
+        self.assertTrue(all(s.group == "hall" for s in states))
+        self.assertIsInstance(states[0], fremen.NamedState)
+        with self.assertRaises(fremen.NotFound):
+            list(self.client.list_states("doors", group="no-such-group"))
+
     def test_anomalies_flag_the_unexpected(self):
         self.fill_doors()
         check = self.client.anomalies("doors", [1.0, 0.0, 1.0], [NIGHT, NOON, NOON], 0.7,

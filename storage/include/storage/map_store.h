@@ -168,6 +168,10 @@ class MapStore {
   // observed[i]: whether keys[i] was ever observed.
   virtual std::vector<uint8_t> Observed(std::span<const uint64_t> keys) const = 0;
   virtual std::optional<std::pair<std::string, std::string>> Label(uint64_t key) const = 0;
+  // Every labelled state (a batch named it or gave it a group), or only those of `group` when it
+  // is not empty (NOT_FOUND when no state has that group); in (name, key) order. Linear in the
+  // labels: a listing copies them all, as a dashboard's page of a generic map does.
+  virtual absl::StatusOr<std::vector<StateLabel>> Labels(const std::string& group) const = 0;
   // The n states of `group` most likely to be 1 at t, most likely first.
   virtual absl::StatusOr<std::vector<std::pair<uint64_t, float>>> TopN(const std::string& group, double t,
                                                                        size_t n,
