@@ -654,6 +654,13 @@ std::vector<uint8_t> MapStoreImpl::Observed(std::span<const uint64_t> keys) cons
   return out;
 }
 
+absl::StatusOr<std::vector<uint64_t>> MapStoreImpl::GroupMembers(const std::string& group) const {
+  base::MutexLock lock(&groups_mutex_);
+  auto it = groups_.find(group);
+  if (it == groups_.end()) return absl::NotFoundError(absl::StrCat("map ", info_.name, " has no group \"", group, "\""));
+  return it->second;
+}
+
 absl::StatusOr<std::vector<StateLabel>> MapStoreImpl::Labels(const std::string& group) const {
   std::vector<StateLabel> labels;
   if (group.empty()) {
@@ -663,17 +670,10 @@ absl::StatusOr<std::vector<StateLabel>> MapStoreImpl::Labels(const std::string& 
       });
     }
   } else {
-    std::vector<uint64_t> members;
-    {
-      base::MutexLock lock(&groups_mutex_);
-      auto it = groups_.find(group);
-      if (it == groups_.end()) {
-        return absl::NotFoundError(absl::StrCat("map ", info_.name, " has no group \"", group, "\""));
-      }
-      members = it->second;
-    }
-    labels.reserve(members.size());
-    for (uint64_t key : members) {
+    auto members = GroupMembers(group);
+    if (!members.ok()) return members.status();
+    labels.reserve(members->size());
+    for (uint64_t key : *members) {
       // A member's label can only have been replaced by a later batch naming it again; its group
       // then still says whether it belongs here.
       if (auto label = Label(key); label && label->second == group) {
@@ -689,19 +689,12 @@ absl::StatusOr<std::vector<StateLabel>> MapStoreImpl::Labels(const std::string& 
 
 absl::StatusOr<std::vector<std::pair<uint64_t, float>>> MapStoreImpl::TopN(const std::string& group, double t, size_t n,
                                                                       const PredictOptions& options) const {
-  std::vector<uint64_t> members;
-  {
-    base::MutexLock lock(&groups_mutex_);
-    auto it = groups_.find(group);
-    if (it == groups_.end()) {
-      return absl::NotFoundError(absl::StrCat("map ", info_.name, " has no group \"", group, "\""));
-    }
-    members = it->second;
-  }
+  auto members = GroupMembers(group);
+  if (!members.ok()) return members.status();
   const model::PhasorTable table(settings_->periods, t);
   std::vector<std::pair<uint64_t, float>> ranked;
-  ranked.reserve(members.size());
-  for (uint64_t key : members) ranked.emplace_back(key, ShardFor(key).Predict(key, table, options));
+  ranked.reserve(members->size());
+  for (uint64_t key : *members) ranked.emplace_back(key, ShardFor(key).Predict(key, table, options));
   const size_t keep = std::min(n, ranked.size());
   std::partial_sort(ranked.begin(), ranked.begin() + keep, ranked.end(), [](const auto& a, const auto& b) {
     return a.second != b.second ? a.second > b.second : a.first < b.first;

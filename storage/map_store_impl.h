@@ -128,6 +128,8 @@ class MapStoreImpl final : public MapStore {
   // Classifies, encodes and splits a batch.
   Pending Prepare(ObservationBatch batch, AckCallback done) const;
   void IndexLabels(std::span<const StateLabel> labels) ABSL_LOCKS_EXCLUDED(groups_mutex_);
+  // A copy of `group`'s keys (Labels, TopN); NOT_FOUND naming the group when no state has it.
+  absl::StatusOr<std::vector<uint64_t>> GroupMembers(const std::string& group) const ABSL_LOCKS_EXCLUDED(groups_mutex_);
   // Whether the queue takes n more observations. One batch is always let in, however big, so that
   // a single huge scan is not refused forever.
   bool FitsLocked(uint64_t n) const ABSL_SHARED_LOCKS_REQUIRED(queue_mutex_) {
