@@ -17,6 +17,8 @@ packages=(
   mypy python3-pycodestyle  # the Python package's type and style checks (python.mypy, python.pycodestyle)
   openssl  # the tests make their TLS certificates with it
   prometheus  # e2e.HttpPrometheusTest: a real Prometheus scrapes fremend's /metrics
+  libjs-chart.js  # Chart.js, embedded in fremend's dashboard at build time (docs/http.md, "Dashboard")
+  chromium chromium-driver python3-selenium  # e2e.dashboard_browser: the dashboard in a real, headless browser
 )
 case "${1:-}" in
   fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;  # libclang_rt.fuzzer, asan and ubsan for clang

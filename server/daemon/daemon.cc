@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "server/dashboard/dashboard_routes.h"
 #include "server/http/health_routes.h"
 #include "server/metrics/metrics_route.h"
 #include "server/services/admin_service.h"
@@ -192,6 +193,7 @@ void Daemon::AddHttpRoutes(httplib::Server& routes) {
     return stopped_ ? "shutting down" : "recovering the maps";
   });
   AddMetricsRoute(routes, &metrics_, &auth_);
+  AddDashboardRoutes(routes);
 }
 
 absl::Status Daemon::PrepareUpdates() {
