@@ -57,6 +57,12 @@ TEST_F(HttpDashboardTest, StaticFilesAreServedWithTheirTypes) {
               name.ends_with(".css") ? "text/css; charset=utf-8" : "text/javascript; charset=utf-8")
         << name;
   }
+  // The icon browsers ask for by themselves.
+  const httplib::Result icon = Get("/favicon.ico");
+  ASSERT_TRUE(icon);
+  EXPECT_EQ(icon->status, 200);
+  EXPECT_EQ(icon->get_header_value("Content-Type"), "image/svg+xml");
+  EXPECT_EQ(icon->body, SourceFile("server/dashboard/web/favicon.svg"));
   // Chart.js, Debian's build, from the binary.
   const httplib::Result chart = Get("/static/chart.min.js");
   ASSERT_TRUE(chart);

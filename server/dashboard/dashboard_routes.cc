@@ -39,9 +39,13 @@ void Serve(const EmbeddedFile& file, const httplib::Request& request, httplib::R
 }  // namespace
 
 void AddDashboardRoutes(httplib::Server& server) {
+  // index.html and favicon.svg are always embedded (server/CMakeLists.txt lists them).
   server.Get("/", [](const httplib::Request& request, httplib::Response& response) {
-    const EmbeddedFile* index = FindEmbeddedFile("index.html");
-    if (index != nullptr) Serve(*index, request, response);
+    Serve(*FindEmbeddedFile("index.html"), request, response);
+  });
+  // Browsers ask for /favicon.ico on their own (for pages that are not HTML, too).
+  server.Get("/favicon.ico", [](const httplib::Request& request, httplib::Response& response) {
+    Serve(*FindEmbeddedFile("favicon.svg"), request, response);
   });
   server.Get(R"(/static/([^/]+))", [](const httplib::Request& request, httplib::Response& response) {
     const std::string name = request.matches[1];

@@ -53,6 +53,7 @@ TEST(EmbeddedFilesTest, ContentTypesFollowTheExtension) {
   EXPECT_EQ(FindEmbeddedFile("style.css")->content_type, "text/css; charset=utf-8");
   EXPECT_EQ(FindEmbeddedFile("app.js")->content_type, "text/javascript; charset=utf-8");
   EXPECT_EQ(FindEmbeddedFile("chart.min.js")->content_type, "text/javascript; charset=utf-8");
+  EXPECT_EQ(FindEmbeddedFile("favicon.svg")->content_type, "image/svg+xml");
 }
 
 TEST(EmbeddedFilesTest, EtagsAreQuotedSha256sAndDiffer) {

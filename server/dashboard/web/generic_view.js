@@ -29,8 +29,8 @@ export async function render(root, mapName, params) {
   mapSelect.addEventListener('change', () => { location.hash = '#/generic/' + encodeURIComponent(mapSelect.value); });
   const tableBox = el('div', {});
   const topBox = el('div', {id: 'top-states'});
-  const groupSelect = el('select', {id: 'group-select'}, groups.map((g) => el('option', {value: g}, g)));
-  const topN = el('input', {id: 'top-n', type: 'number', min: 1, max: 10000, value: 5});
+  const groupSelect = el('select', {id: 'group-select', disabled: !groups.length}, groups.map((g) => el('option', {value: g}, g)));
+  const topN = el('input', {id: 'top-n', type: 'number', min: 1, max: 10000, value: 5, disabled: !groups.length});
   let request = 0;
 
   // The selected order of every listed state (one model call each, at most MAX_LISTED, once).
@@ -61,9 +61,9 @@ export async function render(root, mapName, params) {
     const rows = listed.map((s, j) => el('tr', {'data-name': s.name},
       el('td', {}, modelLink(mapName, s.name)), el('td', {}, s.group || ''), el('td', {class: 'num'}, formatFixed(Number(p[j]), 3)),
       el('td', {class: 'num'}, formatFixed(Number(p[names.length + j]), 3)), el('td', {class: 'num'}, order[j])));
-    tableBox.replaceChildren(
+    tableBox.replaceChildren(el('div', {},
       table(['name', 'group', 'p now (' + formatTime(now) + ')', 'p at t', 'order'], rows, {id: 'states-table'}),
-      states.length > MAX_LISTED ? el('p', {class: 'muted'}, 'The first ' + MAX_LISTED + ' states by name.') : null);
+      states.length > MAX_LISTED ? el('p', {class: 'muted'}, 'The first ' + MAX_LISTED + ' states by name.') : null));
     await showTop(time);
   };
   const slider = timeSlider(centerTime(params), (t) => show(t).catch((e) => tableBox.replaceChildren(el('p', {class: 'error'}, e.message))));

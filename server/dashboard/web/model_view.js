@@ -98,7 +98,11 @@ export async function render(root, mapName, params) {
   }
   const selectedOrder = num(model.selectedOrder);
   let start = parseTime(params.from);
-  if (!Number.isFinite(start)) start = num(model.lastTime) > 0 ? num(model.lastTime) - WEEK : centerOf(params) - WEEK / 2;
+  if (!Number.isFinite(start)) {
+    // The observed week (ending at the state's last observation, from the next midnight UTC), or
+    // the week around the time the model was opened at.
+    start = num(model.lastTime) > 0 ? Math.ceil((num(model.lastTime) - WEEK) / 86400) * 86400 : centerOf(params) - WEEK / 2;
+  }
   start = Math.floor(start / PLOT_STEP) * PLOT_STEP;
 
   const canvas = el('canvas', {id: 'model-chart'});
@@ -124,7 +128,8 @@ export async function render(root, mapName, params) {
       animation: false, maintainAspectRatio: false, parsing: false, normalized: true,
       scales: {
         x: {type: 'linear', min: start, max: start + WEEK, ticks: {stepSize: 43200, callback: (v) => formatTick(v), maxRotation: 0, autoSkip: true}},
-        y: {min: -0.05, max: 1.05, title: {display: true, text: 'p'}},
+        y: {min: -0.02, max: 1.02, title: {display: true, text: 'p'},
+            afterBuildTicks: (axis) => { axis.ticks = [0, 0.2, 0.4, 0.6, 0.8, 1].map((value) => ({value})); }},
       },
       plugins: {tooltip: {callbacks: {title: (items) => formatTime(items[0].parsed.x)}}},
     },

@@ -68,7 +68,7 @@ async function refresh(box) {
     return el('tr', {'data-map': map.name}, cells.map((c, j) => el('td', {class: j === 4 || j === 5 || j === 6 ? 'num' : undefined}, c)));
   });
   const failed = (status.failedMaps || []).map((f) => [f.map, f.error]);
-  box.replaceChildren(
+  box.replaceChildren(el('div', {},
     el('h2', {}, 'Daemon'), statusFacts(status),
     el('h2', {}, 'Maps'),
     maps.length ? table(['map', 'kind', 'size', 'states (dynamic)', 'observations', 'compression', 'ε_p', 'last update', 'ingest rate'],
@@ -76,7 +76,7 @@ async function refresh(box) {
                 : el('p', {class: 'muted'}, 'No maps yet: create one with fremenctl maps create, or try fremenctl demo.'),
     failed.length ? [el('h2', {}, 'Failed maps'), table(['map', 'why'], failed, {id: 'failed-maps'})] : null,
     el('p', {class: 'hint'}, 'Refreshed every ' + REFRESH_MS / 1000 + ' s; ε_p is the mean prediction error of the ' +
-       'dynamic states, compression the raw observations (one bit each) over the bytes of the models.'));
+       'dynamic states, compression the raw observations (one bit each) over the bytes of the models.')));
 }
 
 export async function render(root) {
