@@ -9,7 +9,7 @@ What a person would check by looking, checked on the page itself:
   here with urllib): walls dark, free floor light;
 - moving the time slider from 03:00 to 09:00 changes the doorway cells (the door is shut at night);
 - clicking the door cell opens its model and draws its week of p(t) (the chart has points and its
-  line is on the canvas);
+  line is on the canvas); on a lossless map the model's chart also holds the observed states;
 - the generic map lists its states with p now and at t;
 - "run the update now" with a read token asks for the write token, then shows a done operation.
 A screenshot of each view is written to $FREMEN_ARTIFACTS_DIR (build/test-artifacts/dashboard/).
@@ -43,6 +43,16 @@ MONDAY = 1701043200
 STEP = 15 * 60
 DOORWAY = [(20, 9), (20, 10)]
 WAIT_SECONDS = 60
+# The lossless map "lab": a door open 08:00-18:00 every day of the week before MONDAY, seen every
+# 10 minutes (one observation per lossless slot).
+LAB_SAMPLING = 600
+LAB_TIMES = range(MONDAY - 7 * 86400, MONDAY, LAB_SAMPLING)
+
+
+def lab_door(t):
+    return 1 if 8 <= (t % 86400) / 3600 < 18 else 0
+
+
 _HTTP = re.compile(r"serving HTTP on (\S+) ")
 # Chromium logs every refused fetch; those the dashboard answers with its token prompt are expected.
 _EXPECTED_CONSOLE = re.compile(r"Failed to load resource: the server responded with a status of 40[13]")
@@ -59,8 +69,13 @@ class DashboardBrowserTest(unittest.TestCase):
         cls.daemon = FremendProcess.start(os.path.join(cls.dir.name, "data"), ["--tokens-file", tokens])
         try:
             cls.base = "http://" + _HTTP.search(cls.daemon.log()).group(1)
-            subprocess.run([os.environ["FREMENCTL_BINARY"], "--address", cls.daemon.address, "--token", WRITE_TOKEN,
-                            "demo"], check=True, stdout=subprocess.DEVNULL, timeout=240)
+            cls.fremenctl("demo")
+            # A lossless map: the model view draws its observations (Reconstruct) over p(t).
+            door = os.path.join(cls.dir.name, "door.txt")
+            with open(door, "w") as out:
+                out.writelines(f"{t} {lab_door(t)}\n" for t in LAB_TIMES)
+            cls.fremenctl("maps", "create", "lab", "--generic", "--lossless-sampling", str(LAB_SAMPLING))
+            cls.fremenctl("ingest", "--map", "lab", "--states", door, "--name", "door", "--update")
             cls.artifacts = os.environ.get("FREMEN_ARTIFACTS_DIR", os.path.join(cls.dir.name, "artifacts"))
             os.makedirs(cls.artifacts, exist_ok=True)
             options = webdriver.ChromeOptions()
@@ -74,6 +89,11 @@ class DashboardBrowserTest(unittest.TestCase):
             cls.daemon.kill()
             cls.dir.cleanup()
             raise
+
+    @classmethod
+    def fremenctl(cls, *args):
+        subprocess.run([os.environ["FREMENCTL_BINARY"], "--address", cls.daemon.address, "--token", WRITE_TOKEN, *args],
+                       check=True, stdout=subprocess.DEVNULL, timeout=240)
 
     @classmethod
     def tearDownClass(cls):
@@ -158,8 +178,8 @@ class DashboardBrowserTest(unittest.TestCase):
         return {(x, y): r for x, y, r, _, _ in values}
 
     def region(self, time):
-        answer = self.api("/v1/maps/demo-office/region", {"lo.x": 0, "lo.y": 0, "hi.x": 40, "hi.y": 20, "time": time,
-                                                         "output": "REGION_OUTPUT_FLOAT"})
+        box = {"lo.x": 0, "lo.y": 0, "hi.x": 40, "hi.y": 20}
+        answer = self.api("/v1/maps/demo-office/region", {**box, "time": time, "output": "REGION_OUTPUT_FLOAT"})
         values = answer["floatValues"]
         self.assertEqual(len(values), 40 * 20)
         return {(i % 40, i // 40): float(p) for i, p in enumerate(values)}
@@ -219,7 +239,8 @@ class DashboardBrowserTest(unittest.TestCase):
         self.assertEqual(night[(0, 0)], morning[(0, 0)])
         # Play walks the slider forward, a drawn frame at a time.
         self.browser.find_element(By.ID, "play-button").click()
-        self.wait(lambda: int(self.js("return document.getElementById('time-slider').value")) >= 40, "play did not advance")
+        self.wait(lambda: int(self.js("return document.getElementById('time-slider').value")) >= 40,
+                  "play did not advance")
         self.browser.find_element(By.ID, "play-button").click()
         # Hovering a cell tells its p.
         canvas = self.browser.find_element(By.ID, "grid-canvas")
@@ -258,6 +279,23 @@ class DashboardBrowserTest(unittest.TestCase):
         self.assertIn("τ", self.browser.find_element(By.ID, "persistence").text)
         self.screenshot("model")
 
+    def test_a_lossless_states_model_draws_its_observations(self):
+        self.open("/model/lab?name=door")
+        self.wait_ready()
+        datasets = self.js("""return Chart.getChart(document.getElementById('model-chart')).data.datasets
+                                  .map((d) => d.data.map((p) => [p.x, p.y]));""")
+        self.assertEqual(len(datasets), 2)  # p(t) and the observed states
+        predicted, observed = datasets
+        self.assertEqual(len(predicted), 7 * 24 * 12 + 1)
+        # The plotted week is the observed one; every slot of it is drawn at its middle, with the
+        # state that was ingested there.
+        self.assertEqual(len(observed), len(LAB_TIMES))
+        for (x, y), t in zip(observed, LAB_TIMES):
+            self.assertEqual((x, y), (t + LAB_SAMPLING / 2, lab_door(t)))
+        self.assertIn("lossless history", self.browser.find_element(By.ID, "model-caption").text)
+        self.assertIn("ε_e / ε_p", self.browser.find_element(By.ID, "lossless").text)
+        self.screenshot("model-lossless")
+
     def test_the_generic_map_lists_its_states(self):
         self.open(f"/generic/demo-states?t={MONDAY + 13 * 3600}")
         self.wait_ready()
@@ -286,8 +324,8 @@ class DashboardBrowserTest(unittest.TestCase):
         self.browser.find_element(By.ID, "token-save").click()
         name = self.wait(lambda: self.js("return document.getElementById('run-update-result').dataset.operation"),
                          "the update did not start")
-        self.wait(lambda: self.browser.find_elements(By.CSS_SELECTOR, f"#operations-table tr[data-operation='{name}']"
-                                                                      "[data-stage='done']"), "the operation never showed done")
+        done_row = f"#operations-table tr[data-operation='{name}'][data-stage='done']"
+        self.wait(lambda: self.browser.find_elements(By.CSS_SELECTOR, done_row), "the operation never showed done")
         self.wait(lambda: name in self.browser.find_element(By.ID, "last-job").text, "the last job is not the new one")
         self.assertIn("No failed maps.", self.browser.find_element(By.ID, "failed-maps").text)
         self.screenshot("jobs")
