@@ -109,6 +109,19 @@ export async function listAll(path, field, query = {}, limit = 10000) {
   return items;
 }
 
+// The maps of one kind ('MAP_KIND_GRID', 'MAP_KIND_GENERIC') and the one a view shows: `chosen`,
+// else the first of them ('' when there is none).
+export async function mapsOfKind(kind, chosen) {
+  const maps = (await listAll('/v1/maps', 'maps')).filter((m) => m.kind === kind);
+  return {maps, name: chosen || (maps.length ? maps[0].name : '')};
+}
+
+// A bytes field of protobuf's JSON mapping (base64) → its bytes.
+export function bytesField(base64) {
+  const binary = atob(base64 || '');
+  return Uint8Array.from(binary, (c) => c.charCodeAt(0));
+}
+
 export function mapPath(map) {
   return '/v1/maps/' + encodeURIComponent(map);
 }

@@ -1,7 +1,7 @@
 // A generic map's named states: GET /v1/maps/{map}/states (name, group), p now and at the slider's
 // time t from one POST :predict by names, each state's selected order from GET …/model, and the
 // top n of a group at t from POST :topStates. A state's name opens its model.
-import {api, listAll, mapPath} from './api.js';
+import {api, listAll, mapPath, mapsOfKind} from './api.js';
 import {el, formatFixed, formatTime, num, table} from './format.js';
 import {centerTime, timeSlider} from './time_slider.js';
 
@@ -12,14 +12,12 @@ function modelLink(mapName, name) {
 }
 
 export async function render(root, mapName, params) {
-  const genericMaps = (await listAll('/v1/maps', 'maps')).filter((m) => m.kind === 'MAP_KIND_GENERIC');
-  if (!mapName) {
-    if (!genericMaps.length) {
-      root.append(el('p', {class: 'muted'}, 'No generic map: create one (fremenctl maps create --kind generic) or run fremenctl demo.'));
-      return null;
-    }
-    mapName = genericMaps[0].name;
+  const {maps: genericMaps, name} = await mapsOfKind('MAP_KIND_GENERIC', mapName);
+  if (!name) {
+    root.append(el('p', {class: 'muted'}, 'No generic map: create one (fremenctl maps create NAME --generic) or run fremenctl demo.'));
+    return null;
   }
+  mapName = name;
   const states = await listAll(mapPath(mapName) + '/states', 'states', {}, MAX_LISTED);
   const listed = states.slice(0, MAX_LISTED);
   const names = listed.map((s) => s.name);

@@ -8,24 +8,17 @@
 // For tests and scripts the canvas says what it shows in data attributes: data-map, data-mode,
 // data-z, data-time (the time of the region drawn last), data-scale (canvas pixels per cell),
 // data-offset-x / data-offset-y (where the image's top-left corner is) and data-height (cells in y).
-import {api, listAll, mapPath} from './api.js';
+import {api, bytesField, mapPath, mapsOfKind} from './api.js';
 import {el, formatTime, num} from './format.js';
 import {centerTime, timeSlider} from './time_slider.js';
 
 const OUTPUTS = {probability: 'REGION_OUTPUT_FLOAT', entropy: 'REGION_OUTPUT_ENTROPY', state: 'REGION_OUTPUT_STATES'};
 const MAX_CANVAS = {width: 960, height: 600};
 
-function decodeBase64(text) {
-  const binary = atob(text || '');
-  const bytes = new Uint8Array(binary.length);
-  for (let i = 0; i < binary.length; ++i) bytes[i] = binary.charCodeAt(i);
-  return bytes;
-}
-
 // The region's values as numbers in [0, 1] (p, H or the 0/1 state), x fastest then y.
 export function regionValues(response, mode, cells) {
   if (mode === 'state') {
-    const bytes = decodeBase64(response.bytesValues);
+    const bytes = bytesField(response.bytesValues);
     return Float32Array.from({length: cells}, (_, i) => bytes[i] || 0);
   }
   const values = response.floatValues || [];
@@ -38,14 +31,13 @@ export function grayOf(value) {
 }
 
 export async function render(root, mapName, params) {
-  const gridMaps = (await listAll('/v1/maps', 'maps')).filter((m) => m.kind === 'MAP_KIND_GRID');
-  if (!mapName) {
-    if (!gridMaps.length) {
-      root.append(el('p', {class: 'muted'}, 'No grid map: create one (fremenctl maps create --kind grid) or run fremenctl demo.'));
-      return null;
-    }
-    mapName = gridMaps[0].name;
+  const {maps: gridMaps, name} = await mapsOfKind('MAP_KIND_GRID', mapName);
+  if (!name) {
+    root.append(el('p', {class: 'muted'}, 'No grid map: create one (fremenctl maps create NAME --resolution R --size X Y) ' +
+                   'or run fremenctl demo.'));
+    return null;
   }
+  mapName = name;
   const map = (await api(mapPath(mapName))).map;
   const size = map.grid?.size || {};
   const width = num(size.x), height = num(size.y), depth = Math.max(1, num(size.z));

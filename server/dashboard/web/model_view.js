@@ -4,7 +4,7 @@
 // observed states of that week from POST :reconstruct drawn over it.
 // Route: #/model/MAP?x=&y=&z= (a grid cell) or ?name= (a generic state); from= the week's start
 // (seconds; default: the week before the state's last observation), t= the time it was opened at.
-import {api, mapPath} from './api.js';
+import {api, bytesField, mapPath} from './api.js';
 import {el, formatCount, formatDuration, formatFixed, formatTick, formatTime, num, parseTime, table} from './format.js';
 
 const WEEK = 7 * 86400;
@@ -17,11 +17,6 @@ function refsOf(params) {
   const x = num(params.x), y = num(params.y), z = num(params.z);
   return {label: 'cell (' + x + ', ' + y + (z ? ', ' + z : '') + ')',
           query: {'state.cell.x': x, 'state.cell.y': y, 'state.cell.z': z}, refs: {cells: {x: [x], y: [y], z: [z]}}};
-}
-
-function decodeBase64(text) {
-  const binary = atob(text || '');
-  return Uint8Array.from(binary, (c) => c.charCodeAt(0));
 }
 
 function componentsTable(components, id) {
@@ -77,7 +72,7 @@ function modelTables(model, selectedOrder) {
 async function observationsOf(mapName, map, refs, start, end) {
   if (!(num(map.losslessSamplingSeconds) > 0)) return null;
   const history = await api(mapPath(mapName) + ':reconstruct', {method: 'POST', body: {states: refs, startTime: start, endTime: end}});
-  const slots = decodeBase64(history.histories?.[0]?.slots);
+  const slots = bytesField(history.histories?.[0]?.slots);
   const first = num(history.firstSlotTime), step = num(history.slotSeconds);
   const points = [];
   slots.forEach((s, i) => { if (s !== 2) points.push({x: first + (i + 0.5) * step, y: s}); });
