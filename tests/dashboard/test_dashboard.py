@@ -19,6 +19,7 @@ Environment (set by tests/CMakeLists.txt): FREMEND_BINARY, FREMENCTL_BINARY, FRE
 PYTHONPATH with build/python (the fremen package) and client/python/tests (its daemon harness).
 """
 
+import base64
 import json
 import os
 import re
@@ -170,13 +171,14 @@ class DashboardBrowserTest(unittest.TestCase):
         return (float(d["offsetX"]) + (x + 0.5) * scale, float(d["offsetY"]) + (int(d["height"]) - 1 - y + 0.5) * scale)
 
     def grays(self):
-        """The gray of every cell's center on the canvas, {(x, y): gray}."""
+        """The gray of every cell's center on the canvas, {(x, y): gray}; None for cells off it."""
         d = self.js("return Object.assign({}, document.getElementById('grid-canvas').dataset)")
         width, height = int(d["width"]), int(d["height"])
         centers = [[x, y, *self.cell_pixel(x, y)] for y in range(height) for x in range(width)]
         values = self.js("""
-            const g = document.getElementById('grid-canvas').getContext('2d');
+            const c = document.getElementById('grid-canvas'), g = c.getContext('2d');
             return arguments[0].map(([x, y, px, py]) => {
+              if (px < 0 || py < 0 || px >= c.width || py >= c.height) return [x, y, null, null, null];
               const p = g.getImageData(Math.floor(px), Math.floor(py), 1, 1).data;
               return [x, y, p[0], p[1], p[2]];
             });""", centers)
@@ -227,6 +229,45 @@ class DashboardBrowserTest(unittest.TestCase):
         self.assertTrue(all(grays[cell] > 229 for cell in floor))
         self.assertLess(grays[(0, 0)], 26)  # a corner of the outer wall
         self.screenshot("grid", height=870)  # README.md's docs/dashboard.png
+
+    def test_entropy_and_state_modes_and_zoom_draw_what_the_region_says(self):
+        self.open(f"/grid/demo-office?t={MONDAY}")
+        self.wait_ready()
+        time = self.set_slider(36)
+        canvas = self.browser.find_element(By.ID, "grid-canvas")
+        box = {"lo.x": 0, "lo.y": 0, "hi.x": 40, "hi.y": 20, "time": time}
+
+        Select(self.browser.find_element(By.ID, "mode-select")).select_by_value("entropy")
+        self.wait(lambda: canvas.get_attribute("data-mode") == "entropy", "no entropy map")
+        entropy = self.api("/v1/maps/demo-office/region", {**box, "output": "REGION_OUTPUT_ENTROPY"})["floatValues"]
+        grays = self.grays()
+        for i, h in enumerate(entropy):
+            self.assertAlmostEqual(grays[(i % 40, i // 40)], round(255 * (1 - float(h))), delta=1)
+
+        Select(self.browser.find_element(By.ID, "mode-select")).select_by_value("state")
+        field = self.browser.find_element(By.ID, "confidence")
+        field.clear()
+        field.send_keys("0.3\n")
+        self.wait(lambda: canvas.get_attribute("data-mode") == "state" and "c = 0.3" in
+                  self.browser.find_element(By.ID, "grid-status").text, "no state map at c = 0.3")
+        states = self.api("/v1/maps/demo-office/region", {**box, "output": "REGION_OUTPUT_STATES", "confidence": 0.3})
+        occupied = base64.b64decode(states["bytesValues"])
+        grays = self.grays()
+        for i, s in enumerate(occupied):
+            self.assertEqual(grays[(i % 40, i // 40)], 0 if s else 255, f"cell {(i % 40, i // 40)}")
+
+        # The wheel zooms about the cursor; the cells stay where the canvas says they are.
+        scale = float(canvas.get_attribute("data-scale"))
+        self.js("""const c = document.getElementById('grid-canvas'), b = c.getBoundingClientRect();
+                   c.dispatchEvent(new WheelEvent('wheel', {deltaY: -100, clientX: b.left + 100, clientY: b.top + 100,
+                                                            bubbles: true, cancelable: true}));""")
+        self.assertAlmostEqual(float(canvas.get_attribute("data-scale")), scale * 1.25)
+        zoomed = self.grays()
+        visible = [i for i in range(40 * 20) if zoomed[(i % 40, i // 40)] is not None]
+        self.assertGreater(len(visible), 100)
+        for i in visible:
+            self.assertEqual(zoomed[(i % 40, i // 40)], 0 if occupied[i] else 255)
+        self.screenshot("grid-states-zoomed")
 
     def test_moving_the_slider_from_03_to_09_changes_the_doorway(self):
         self.open(f"/grid/demo-office?t={MONDAY}")
