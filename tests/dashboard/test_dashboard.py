@@ -77,6 +77,8 @@ class DashboardBrowserTest(unittest.TestCase):
                 out.writelines(f"{t} {lab_door(t)}\n" for t in LAB_TIMES)
             cls.fremenctl("maps", "create", "lab", "--generic", "--lossless-sampling", str(LAB_SAMPLING))
             cls.fremenctl("ingest", "--map", "lab", "--states", door, "--name", "door", "--update")
+            # A map the overview watches while observations arrive (its live ingest rate).
+            cls.fremenctl("maps", "create", "feed", "--generic")
             cls.artifacts = os.environ.get("FREMEN_ARTIFACTS_DIR", os.path.join(cls.dir.name, "artifacts"))
             os.makedirs(cls.artifacts, exist_ok=True)
             options = webdriver.ChromeOptions()
@@ -210,6 +212,16 @@ class DashboardBrowserTest(unittest.TestCase):
         self.assertIn("generic", states)
         self.assertIn("3,024", states)
         self.assertIn("fremend", self.browser.find_element(By.ID, "server-line").text)
+        # Observations arriving show as a rate (the change of the count between two refreshes).
+        rate = "#maps-table tr[data-map='feed'] td[data-column='rate']"
+        self.assertIn(self.browser.find_element(By.CSS_SELECTOR, rate).text, ["—", "0.0 /s"])  # nothing arrived yet
+        feed = os.path.join(self.dir.name, "feed.txt")
+        with open(feed, "w") as out:
+            out.writelines(f"{MONDAY + 60 * i} {i % 2}\n" for i in range(200))
+        self.fremenctl("ingest", "--map", "feed", "--states", feed, "--name", "sensor")
+        self.wait(lambda: re.fullmatch(r"[\d.]+ /s", self.browser.find_element(By.CSS_SELECTOR, rate).text)
+                  and float(self.browser.find_element(By.CSS_SELECTOR, rate).text.split()[0]) > 0,
+                  "no ingest rate after the ingest")
         self.screenshot("overview")
 
     def test_the_grid_canvas_shows_walls_dark_and_free_floor_light_as_the_region_says(self):

@@ -61,11 +61,16 @@ async function refresh(box) {
   const rows = maps.map((map, i) => {
     const s = stats[i];
     if (s.error) return el('tr', {'data-map': map.name}, el('td', {}, mapLink(map)), el('td', {colspan: 8, class: 'error'}, s.error.message));
-    const cells = [mapLink(map), map.kind === 'MAP_KIND_GRID' ? 'grid' : 'generic', sizeOf(map),
-                   formatCount(s.states) + ' (' + formatCount(s.dynamicStates) + ')', formatCount(s.observations),
-                   formatFixed(num(s.compressionRatio), 1), formatFixed(num(s.meanPredictionError), 3), lastUpdateOf(s),
-                   rateOf(map.name, num(s.observations), now)];
-    return el('tr', {'data-map': map.name}, cells.map((c, j) => el('td', {class: j === 4 || j === 5 || j === 6 ? 'num' : undefined}, c)));
+    const compression = num(s.compressionRatio);
+    const cells = [['map', mapLink(map)], ['kind', map.kind === 'MAP_KIND_GRID' ? 'grid' : 'generic'], ['size', sizeOf(map)],
+                   ['states', formatCount(s.states) + ' (' + formatCount(s.dynamicStates) + ')'],
+                   ['observations', formatCount(s.observations)],
+                   ['compression', formatFixed(compression, compression < 10 ? 2 : 1)],
+                   ['error', formatFixed(num(s.meanPredictionError), 3)], ['update', lastUpdateOf(s)],
+                   ['rate', rateOf(map.name, num(s.observations), now)]];
+    const numeric = new Set(['observations', 'compression', 'error', 'rate']);
+    return el('tr', {'data-map': map.name},
+              cells.map(([column, c]) => el('td', {'data-column': column, class: numeric.has(column) ? 'num' : undefined}, c)));
   });
   const failed = (status.failedMaps || []).map((f) => [f.map, f.error]);
   box.replaceChildren(el('div', {},
