@@ -45,6 +45,9 @@ TEST_F(HttpDashboardTest, TheRootServesTheIndexPage) {
   EXPECT_THAT(index->body, HasSubstr("/static/chart.min.js"));
   EXPECT_EQ(index->get_header_value("Cache-Control"), "no-cache");
   EXPECT_THAT(index->get_header_value("ETag"), StartsWith("\""));
+  EXPECT_THAT(index->get_header_value("Content-Security-Policy"), HasSubstr("default-src 'self'"));
+  EXPECT_THAT(index->get_header_value("Content-Security-Policy"), HasSubstr("frame-ancestors 'none'"));
+  EXPECT_EQ(index->get_header_value("X-Content-Type-Options"), "nosniff");
 }
 
 TEST_F(HttpDashboardTest, StaticFilesAreServedWithTheirTypes) {

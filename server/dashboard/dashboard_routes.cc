@@ -29,6 +29,9 @@ void Serve(const EmbeddedFile& file, const httplib::Request& request, httplib::R
   response.set_header("ETag", std::string(file.etag));
   response.set_header("Cache-Control", "no-cache");
   response.set_header("X-Content-Type-Options", "nosniff");
+  // The pages load only their own files and call only this origin; no other site may frame them
+  // (a framed "run the update now" could be clicked by a user who does not see it).
+  response.set_header("Content-Security-Policy", "default-src 'self'; img-src 'self' data:; frame-ancestors 'none'");
   if (Matches(request.get_header_value("If-None-Match"), file.etag)) {
     response.status = 304;
     return;
