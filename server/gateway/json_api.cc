@@ -2,6 +2,7 @@
 
 #include <google/protobuf/util/json_util.h>
 
+#include <map>
 #include <set>
 #include <utility>
 
@@ -33,6 +34,16 @@ absl::Status FromGrpc(const grpc::Status& status) {
   return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
 }
 
+// The parameters of the URL's query string only: httplib's `params` also holds a form-encoded
+// body's fields (what `curl -d` sends by default), which here is JSON, not parameters.
+std::multimap<std::string, std::string> QueryParams(const httplib::Request& http) {
+  httplib::Params params;
+  if (const size_t question = http.target.find('?'); question != std::string::npos) {
+    httplib::detail::parse_query_text(http.target.substr(question + 1), params);
+  }
+  return params;
+}
+
 // The request message of `http` for a route of `source`.
 absl::Status ParseRequest(const httplib::Request& http, Source source, const PathVariables& variables,
                           google::protobuf::Message& request) {
@@ -42,7 +53,7 @@ absl::Status ParseRequest(const httplib::Request& http, Source source, const Pat
       return absl::InvalidArgumentError(absl::StrCat("request body: ", std::string(parsed.message())));
     }
   }
-  if (absl::Status s = SetFieldsFromQuery(http.params, request); !s.ok()) return s;
+  if (absl::Status s = SetFieldsFromQuery(QueryParams(http), request); !s.ok()) return s;
   for (const auto& [name, value] : variables) {
     if (absl::Status s = SetField(name, value, request); !s.ok()) {
       return absl::InvalidArgumentError(absl::StrCat("path variable ", name, ": ", s.message()));
@@ -89,7 +100,7 @@ Handler Forward(Forwarder<Request, Response> forward, Source source) {
 // GET /v1/maps/{map}/region.png (region_png.h).
 void RegionPngRoute(const std::shared_ptr<grpc::Channel>& channel, const httplib::Request& http,
                     const PathVariables& variables, httplib::Response& response) {
-  auto request = RegionPngRequest(http.params);
+  auto request = RegionPngRequest(QueryParams(http));
   if (!request.ok()) return SetErrorResponse(request.status(), response);
   for (const auto& [name, value] : variables) (void)SetField(name, value, *request);  // {map}: a string
   v1::PredictRegionResponse region;
@@ -181,6 +192,22 @@ void AddJsonApi(httplib::Server& server, ChannelSource channel) {
   // No route takes them, but their answer is a Status body too rather than httplib's empty 400.
   server.Put(pattern, dispatch);
   server.Patch(pattern, dispatch);
+  // httplib answers some requests before any route sees them — a POST without a body or
+  // Content-Length is 400 with an empty body: give those a Status body too.
+  server.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& http,
+                                                                    httplib::Response& response) {
+    if (!response.body.empty() || (http.path != "/v1" && http.path.rfind("/v1/", 0) != 0)) {
+      return httplib::Server::HandlerResponse::Unhandled;
+    }
+    const int status = response.status;
+    SetErrorResponse(status == 400 ? absl::InvalidArgumentError(absl::StrCat(
+                                         "cannot read the ", http.method, " request: send a body (at least {}) or ",
+                                         "Content-Length: 0"))
+                                   : absl::UnknownError(absl::StrCat("HTTP status ", status)),
+                     response);
+    response.status = status;
+    return httplib::Server::HandlerResponse::Handled;
+  }));
 }
 
 }  // namespace fremen::server
