@@ -51,70 +51,60 @@ absl::StatusOr<const EnumValueDescriptor*> ParseEnum(absl::string_view dotted, a
   return Bad(dotted, absl::StrCat("not a value of ", type->full_name()), value);
 }
 
+// Reflection's setter (or adder) of a field of type T.
+template <typename T>
+using Setter = void (Reflection::*)(Message*, const FieldDescriptor*, T) const;
+
+// Sets `v`, or appends it to a repeated field.
+template <typename T>
+absl::Status Store(const FieldDescriptor& field, Message& message, T v, Setter<T> set, Setter<T> add) {
+  (message.GetReflection()->*(field.is_repeated() ? add : set))(&message, &field, std::move(v));
+  return absl::OkStatus();
+}
+
+template <typename T>
+absl::Status StoreInteger(absl::string_view dotted, absl::string_view value, const FieldDescriptor& field,
+                          Message& message, Setter<T> set, Setter<T> add) {
+  T v = 0;
+  if (absl::Status s = ParseInteger(dotted, value, field, v); !s.ok()) return s;
+  return Store(field, message, v, set, add);
+}
+
 // Sets or appends `value` to the scalar `field` of `message`.
 absl::Status SetScalar(absl::string_view dotted, absl::string_view value, const FieldDescriptor& field,
                        Message& message) {
-  const Reflection& r = *message.GetReflection();
-  const bool repeated = field.is_repeated();
   switch (field.cpp_type()) {
-    case FieldDescriptor::CPPTYPE_INT32: {
-      int32_t v = 0;
-      if (absl::Status s = ParseInteger(dotted, value, field, v); !s.ok()) return s;
-      repeated ? r.AddInt32(&message, &field, v) : r.SetInt32(&message, &field, v);
-      return absl::OkStatus();
-    }
-    case FieldDescriptor::CPPTYPE_INT64: {
-      int64_t v = 0;
-      if (absl::Status s = ParseInteger(dotted, value, field, v); !s.ok()) return s;
-      repeated ? r.AddInt64(&message, &field, v) : r.SetInt64(&message, &field, v);
-      return absl::OkStatus();
-    }
-    case FieldDescriptor::CPPTYPE_UINT32: {
-      uint32_t v = 0;
-      if (absl::Status s = ParseInteger(dotted, value, field, v); !s.ok()) return s;
-      repeated ? r.AddUInt32(&message, &field, v) : r.SetUInt32(&message, &field, v);
-      return absl::OkStatus();
-    }
-    case FieldDescriptor::CPPTYPE_UINT64: {
-      uint64_t v = 0;
-      if (absl::Status s = ParseInteger(dotted, value, field, v); !s.ok()) return s;
-      repeated ? r.AddUInt64(&message, &field, v) : r.SetUInt64(&message, &field, v);
-      return absl::OkStatus();
-    }
-    case FieldDescriptor::CPPTYPE_DOUBLE: {
-      double v = 0;
-      if (absl::Status s = ParseDouble(dotted, value, v); !s.ok()) return s;
-      repeated ? r.AddDouble(&message, &field, v) : r.SetDouble(&message, &field, v);
-      return absl::OkStatus();
-    }
+    case FieldDescriptor::CPPTYPE_INT32:
+      return StoreInteger<int32_t>(dotted, value, field, message, &Reflection::SetInt32, &Reflection::AddInt32);
+    case FieldDescriptor::CPPTYPE_INT64:
+      return StoreInteger<int64_t>(dotted, value, field, message, &Reflection::SetInt64, &Reflection::AddInt64);
+    case FieldDescriptor::CPPTYPE_UINT32:
+      return StoreInteger<uint32_t>(dotted, value, field, message, &Reflection::SetUInt32, &Reflection::AddUInt32);
+    case FieldDescriptor::CPPTYPE_UINT64:
+      return StoreInteger<uint64_t>(dotted, value, field, message, &Reflection::SetUInt64, &Reflection::AddUInt64);
+    case FieldDescriptor::CPPTYPE_DOUBLE:
     case FieldDescriptor::CPPTYPE_FLOAT: {
       double v = 0;
       if (absl::Status s = ParseDouble(dotted, value, v); !s.ok()) return s;
-      const float f = static_cast<float>(v);
-      repeated ? r.AddFloat(&message, &field, f) : r.SetFloat(&message, &field, f);
-      return absl::OkStatus();
+      if (field.cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE) {
+        return Store<double>(field, message, v, &Reflection::SetDouble, &Reflection::AddDouble);
+      }
+      return Store<float>(field, message, static_cast<float>(v), &Reflection::SetFloat, &Reflection::AddFloat);
     }
     case FieldDescriptor::CPPTYPE_BOOL: {
       const std::string lower = absl::AsciiStrToLower(value);
       if (lower != "true" && lower != "false" && lower != "1" && lower != "0") {
         return Bad(dotted, "not a bool (true, false, 1 or 0)", value);
       }
-      const bool b = lower == "true" || lower == "1";
-      repeated ? r.AddBool(&message, &field, b) : r.SetBool(&message, &field, b);
-      return absl::OkStatus();
+      return Store<bool>(field, message, lower == "true" || lower == "1", &Reflection::SetBool, &Reflection::AddBool);
     }
     case FieldDescriptor::CPPTYPE_ENUM: {
       auto e = ParseEnum(dotted, value, field);
       if (!e.ok()) return e.status();
-      repeated ? r.AddEnum(&message, &field, *e) : r.SetEnum(&message, &field, *e);
-      return absl::OkStatus();
+      return Store<const EnumValueDescriptor*>(field, message, *e, &Reflection::SetEnum, &Reflection::AddEnum);
     }
-    case FieldDescriptor::CPPTYPE_STRING: {
-      // bytes too: the value's bytes as they are.
-      const std::string s(value);
-      repeated ? r.AddString(&message, &field, s) : r.SetString(&message, &field, s);
-      return absl::OkStatus();
-    }
+    case FieldDescriptor::CPPTYPE_STRING:  // bytes too: the value's bytes as they are
+      return Store<std::string>(field, message, std::string(value), &Reflection::SetString, &Reflection::AddString);
     case FieldDescriptor::CPPTYPE_MESSAGE:
       break;
   }
