@@ -4,7 +4,11 @@
 // status, the gRPC code and the gRPC message; the token roles are gRPC's (no token 401, a read
 // token may view but not act, 403; a write token may do both); region.png, decoded, is the JSON
 // region drawn with base/gray_levels.h, row 0 the highest y.
+#include <arpa/inet.h>
 #include <google/protobuf/struct.pb.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 #include <google/protobuf/util/json_util.h>
 #include <google/protobuf/util/message_differencer.h>
 
@@ -555,13 +559,53 @@ TEST_F(HttpApiTest, BadInputsAreTheirGrpcStatusWithItsMessage) {
   }
 }
 
-TEST_F(HttpApiTest, APostWithoutABodyIsAStatusToo) {
+TEST_F(HttpApiTest, ABoxTooBigForOneAnswerIsResourceExhausted) {
+  CreateOverHttp(GridMapSpec("big", 4100, 4100, 0.05));  // 16 810 000 cells > 16 Mi
+  const Answer answer = Call("GET", "/v1/maps/big/region?hi.x=4100&hi.y=4100&output=REGION_OUTPUT_UINT8");
+  EXPECT_EQ(answer.status, 429) << answer.body;
+  EXPECT_THAT(answer.body, HasSubstr("\"code\":8"));
+  EXPECT_THAT(answer.body, HasSubstr("the box [lo, hi) has 16810000 cells"));
+  // The daemon is not left computing it: the next call is answered.
+  Ok<v1::GetMapResponse>("GET", "/v1/maps/big");
+}
+
+// What `curl -X POST URL` sends: no body and no Content-Length, over a raw socket (httplib's client
+// always sends a length).
+std::string RawPostWithoutLength(const std::string& address, const std::string& path) {
+  const HostPort split = SplitHostPort(address);
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<uint16_t>(split.port));
+  inet_pton(AF_INET, split.host.c_str(), &to.sin_addr);
+  EXPECT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&to), sizeof(to)), 0);
+  const std::string request = "POST " + path + " HTTP/1.1\r\nHost: fremend\r\n\r\n";
+  EXPECT_EQ(write(fd, request.data(), request.size()), static_cast<ssize_t>(request.size()));
+  // The answer: its headers, then Content-Length bytes (the connection stays open).
+  std::string answer;
+  char buffer[4096];
+  for (ssize_t n; (n = read(fd, buffer, sizeof(buffer))) > 0;) {
+    answer.append(buffer, static_cast<size_t>(n));
+    const size_t end = answer.find("\r\n\r\n");
+    const size_t length = answer.find("Content-Length: ");
+    if (end == std::string::npos || length == std::string::npos) continue;
+    if (answer.size() >= end + 4 + std::stoul(answer.substr(length + 16))) break;
+  }
+  close(fd);
+  return answer;
+}
+
+TEST_F(HttpApiTest, AnEmptyPostBodyIsTheEmptyRequestAndNoBodyAtAllAStatus) {
   CreateOverHttp(GridMapSpec("lab", kWidth, kHeight, 0.5));
   httplib::Client client = HttpClientFor(daemon_->http_address());
-  // httplib's client sends Content-Length: 0 for an empty body: that is an empty request message.
-  const httplib::Result empty = client.Post("/v1/maps/lab:check", "", "application/json");
+  const httplib::Result empty = client.Post("/v1/maps/lab:check", "", "application/json");  // Content-Length: 0
   ASSERT_TRUE(empty);
   EXPECT_EQ(empty->status, 200) << empty->body;
+  EXPECT_THAT(empty->body, HasSubstr("\"clean\":true"));
+  const std::string raw = RawPostWithoutLength(daemon_->http_address(), "/v1/maps/lab:check");
+  EXPECT_THAT(raw, HasSubstr("HTTP/1.1 411"));  // at once, not after httplib's read timeout
+  EXPECT_THAT(raw, HasSubstr("\"code\":3"));
+  EXPECT_THAT(raw, HasSubstr("a POST needs a body (at least {}) or Content-Length: 0"));
 }
 
 class HttpApiTokenTest : public HttpApiTest {

@@ -192,22 +192,21 @@ void AddJsonApi(httplib::Server& server, ChannelSource channel) {
   // No route takes them, but their answer is a Status body too rather than httplib's empty 400.
   server.Put(pattern, dispatch);
   server.Patch(pattern, dispatch);
-  // httplib answers some requests before any route sees them — a POST without a body or
-  // Content-Length is 400 with an empty body: give those a Status body too.
-  server.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& http,
-                                                                    httplib::Response& response) {
-    if (!response.body.empty() || (http.path != "/v1" && http.path.rfind("/v1/", 0) != 0)) {
+  // httplib would wait its read timeout (30 s) for the body of a POST with neither a body length
+  // nor chunks (`curl -X POST URL` without -d), then answer an empty 400: refuse it at once,
+  // before the body is read, with a Status body (411 Length Required).
+  server.set_pre_routing_handler([](const httplib::Request& http, httplib::Response& response) {
+    const bool has_body_method = http.method == "POST" || http.method == "PUT" || http.method == "PATCH";
+    if (!has_body_method || http.has_header("Content-Length") || http.has_header("Transfer-Encoding") ||
+        (http.path != "/v1" && http.path.rfind("/v1/", 0) != 0)) {
       return httplib::Server::HandlerResponse::Unhandled;
     }
-    const int status = response.status;
-    SetErrorResponse(status == 400 ? absl::InvalidArgumentError(absl::StrCat(
-                                         "cannot read the ", http.method, " request: send a body (at least {}) or ",
-                                         "Content-Length: 0"))
-                                   : absl::UnknownError(absl::StrCat("HTTP status ", status)),
+    SetErrorResponse(absl::InvalidArgumentError(absl::StrCat("a ", http.method, " needs a body (at least {}) or ",
+                                                             "Content-Length: 0")),
                      response);
-    response.status = status;
+    response.status = 411;
     return httplib::Server::HandlerResponse::Handled;
-  }));
+  });
 }
 
 }  // namespace fremen::server
