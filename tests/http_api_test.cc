@@ -13,6 +13,7 @@
 #include <google/protobuf/util/message_differencer.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -453,8 +454,8 @@ TEST_F(HttpApiTest, AdminRoutesAnswerWhatAdminServiceAnswers) {
     EXPECT_THAT(again_http.body, HasSubstr(absl::StrCat("\"code\":", static_cast<int>(again_status.error_code()))));
   }
 
-  // Salvage copies a damaged map (tests/check_test.cc damages one); of a healthy map the answer is
-  // gRPC's refusal, code and message.
+  // Salvage copies a damaged map (SalvageOfADamagedMapReportsWhatGrpcReports); of a healthy map the
+  // answer is gRPC's refusal, code and message.
   v1::SalvageMapRequest salvage;
   salvage.set_map("lab");
   salvage.set_new_map("lab2");
@@ -477,6 +478,69 @@ TEST_F(HttpApiTest, AdminRoutesAnswerWhatAdminServiceAnswers) {
   ExpectSame(restored.map(), lab.map());
   EXPECT_EQ(Ok<v1::GetMapStatsResponse>("GET", "/v1/maps/lab/stats").stats().observations(),
             uint64_t{kBatches} * kWidth * kHeight);
+}
+
+// The only map directory of the (stopped) daemon's data directory.
+std::string OnlyMapDir(const std::string& data_dir) {
+  std::vector<std::filesystem::path> dirs;
+  for (const auto& e : std::filesystem::directory_iterator(data_dir + "/maps")) dirs.push_back(e.path());
+  EXPECT_EQ(dirs.size(), 1u);
+  return dirs.empty() ? "" : dirs.front().string();
+}
+
+TEST_F(HttpApiTest, SalvageOfADamagedMapReportsWhatGrpcReports) {
+  constexpr uint32_t kX = 64, kY = 32;
+  v1::Map map = GridMapSpec("lab", kX, kY, 0.1);
+  map.set_shards(1);
+  CreateOverHttp(map);
+  for (int i = 0; i < 7; ++i) {  // scans of dense patches (bytes as base64 in the JSON body)
+    v1::IngestRequest scan;
+    scan.set_writer_id(3);
+    scan.set_sequence(i + 1);
+    scan.set_time(kT0 + 3600.0 * i);
+    scan.mutable_patch()->mutable_size()->set_x(kX);
+    scan.mutable_patch()->mutable_size()->set_y(kY);
+    scan.mutable_patch()->mutable_size()->set_z(1);
+    scan.mutable_patch()->set_probabilities(std::string(uint64_t{kX} * kY, i % 2 == 1 && i < 6 ? '\xff' : '\0'));
+    ASSERT_EQ(Ok<v1::IngestResponse>("POST", "/v1/maps/lab:ingest", Json(scan)).accepted(), uint64_t{kX} * kY);
+  }
+  StopDaemon();
+  // A page in the middle of the shard zeroed, as a disk would (tests/check_test.cc).
+  const std::string shard = OnlyMapDir(data_dir()) + "/shard-0/data.mdb";
+  const uint64_t pages = std::filesystem::file_size(shard) / 4096;
+  ASSERT_GT(pages, 16u);
+  {
+    std::fstream file(shard, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(static_cast<std::streamoff>(pages / 2 * 4096));
+    const std::string zeros(4096, '\0');
+    file.write(zeros.data(), static_cast<std::streamsize>(zeros.size()));
+  }
+  StartDaemon();
+  ASSERT_FALSE(HasFatalFailure());
+  const auto status = Ok<v1::GetServerStatusResponse>("GET", "/v1/status");
+  ASSERT_EQ(status.failed_maps_size(), 1);
+  EXPECT_EQ(status.failed_maps(0).map(), "lab");
+
+  auto salvaged = Ok<v1::SalvageMapResponse>("POST", "/v1/maps/lab:salvage", R"({"newMap": "lab-http"})");
+  EXPECT_EQ(salvaged.map().name(), "lab-http");
+  EXPECT_GT(salvaged.records_kept(), 0u);
+  EXPECT_GT(salvaged.losses(), 0u);
+  v1::SalvageMapRequest request;
+  request.set_map("lab");
+  request.set_new_map("lab-grpc");
+  v1::SalvageMapResponse salvaged_grpc;
+  const grpc::Status done = admin()->SalvageMap(CallContext().get(), request, &salvaged_grpc);
+  ASSERT_TRUE(done.ok()) << done.error_message();
+  // The same damage, the same report: all but the new map's name, creation time and the duration.
+  for (v1::SalvageMapResponse* report : {&salvaged, &salvaged_grpc}) {
+    report->clear_map();
+    report->clear_duration_seconds();
+  }
+  ExpectSame(salvaged, salvaged_grpc);
+  v1::GetMapRequest get;
+  get.set_map("lab-http");
+  v1::GetMapResponse served;
+  EXPECT_TRUE(maps()->GetMap(CallContext().get(), get, &served).ok());
 }
 
 // The message gRPC gives for `call` (expected to fail with `code`).
