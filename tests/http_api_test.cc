@@ -602,6 +602,7 @@ TEST_F(HttpApiTest, BadInputsAreTheirGrpcStatusWithItsMessage) {
       {"GET", "/v1/maps/rooms/region?hi.x=1&hi.y=1", "", 400, 9, escaped(grid_only)},
       {"GET", "/v1/maps/rooms/region.png?hi.x=1&hi.y=1", "", 400, 9, escaped(grid_only)},
       {"GET", "/v1/maps/lab/region.png?hi.x=1&hi.y=1&mode=heat", "", 400, 3, "query parameter mode"},
+      {"GET", "/v1/maps/lab/writers/abc/lastSequence", "", 400, 3, "path variable writer_id: not an integer: abc"},
       {"GET", "/v1/nothing", "", 404, 5, "no route /v1/nothing"},
       {"GET", "/v1/maps/lab/bogus", "", 404, 5, "no route /v1/maps/lab/bogus"},
       {"DELETE", "/v1/status", "", 405, 12, "DELETE is not a method of /v1/status; it allows GET"},

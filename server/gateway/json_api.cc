@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_replace.h"
 #include "fremen/v1/admin.grpc.pb.h"
 #include "fremen/v1/ingest.grpc.pb.h"
 #include "fremen/v1/maps.grpc.pb.h"
@@ -56,7 +57,8 @@ absl::Status ParseRequest(const httplib::Request& http, Source source, const Pat
   if (absl::Status s = SetFieldsFromQuery(QueryParams(http), request); !s.ok()) return s;
   for (const auto& [name, value] : variables) {
     if (absl::Status s = SetField(name, value, request); !s.ok()) {
-      return absl::InvalidArgumentError(absl::StrCat("path variable ", name, ": ", s.message()));
+      // "query parameter writer_id: not an integer: x" → "path variable writer_id: ...".
+      return absl::InvalidArgumentError(absl::StrReplaceAll(s.message(), {{"query parameter ", "path variable "}}));
     }
   }
   return absl::OkStatus();
