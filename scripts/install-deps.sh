@@ -12,6 +12,7 @@ packages=(
   liblmdb-dev lmdb-utils zlib1g-dev libxxhash-dev libeigen3-dev libspdlog-dev libfftw3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcpp-httplib-dev libssl-dev prometheus-cpp-dev  # fremend's HTTP port: HTTP(S) and Prometheus metrics
+  libpng-dev  # fremend's region.png (server/gateway/png_encode.cc)
   python3-grpcio python3-protobuf python3-numpy
   python3-setuptools python3-wheel python3-venv  # the Python package's wheel, built and installed by python.test_package
   mypy python3-pycodestyle  # the Python package's type and style checks (python.mypy, python.pycodestyle)

@@ -1,10 +1,9 @@
 // Region export (see region_export.h).
 #include "client/formats/region_export.h"
 
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
 
+#include "base/gray_levels.h"
 #include "client/formats/occupancy_pixels.h"
 #include "client/formats/pgm.h"
 #include "client/formats/png.h"
@@ -32,9 +31,7 @@ Image MapServerImage(const ProbabilityPlane& plane, const MapMetadata& metadata)
 }
 
 Image ProbabilityImage(const ProbabilityPlane& plane) {
-  return Render(plane, [](float p) {
-    return static_cast<uint8_t>(std::lround(255.0 * (1.0 - std::clamp(static_cast<double>(p), 0.0, 1.0))));
-  });
+  return Render(plane, [](float p) { return GrayLevel(p); });
 }
 
 MapMetadata ExportMetadata(const ProbabilityPlane& plane, const std::string& image_name, MapMode mode) {

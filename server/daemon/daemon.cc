@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "server/dashboard/dashboard_routes.h"
+#include "server/gateway/json_api.h"
 #include "server/http/health_routes.h"
 #include "server/metrics/metrics_route.h"
 #include "server/services/admin_service.h"
@@ -177,12 +178,19 @@ absl::Status Daemon::StartHttp() {
     DaemonLog()->info("no HTTP port (http_listen is empty)");
     return absl::OkStatus();
   }
+  // The JSON API's channel into the services: the gRPC server is built (StartServer came first),
+  // so its in-process channel exists before any HTTP request does. Its message limits are the
+  // server's own, for the same answers a remote client may get.
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(static_cast<int>(config_.max_message_mb) << 20);
+  args.SetMaxSendMessageSize(static_cast<int>(config_.max_message_mb) << 20);
+  gateway_channel_ = server_->InProcessChannel(args);
   http_ = std::make_unique<HttpServer>(HttpServer::Options{config_.http_listen, config_.tls_cert_file,
                                                            config_.tls_key_file, config_.tls_client_ca_file});
   AddHttpRoutes(http_->routes());
   if (absl::Status s = http_->Start(); !s.ok()) return s;
-  DaemonLog()->info("serving HTTP on {}{} (/metrics, /healthz, /readyz)", http_->address(),
-                    http_->tls() ? " with TLS" : "");
+  DaemonLog()->info("serving HTTP on {}{} (the dashboard at /, /v1/... JSON API, /metrics, /healthz, /readyz)",
+                    http_->address(), http_->tls() ? " with TLS" : "");
   return absl::OkStatus();
 }
 
@@ -194,6 +202,8 @@ void Daemon::AddHttpRoutes(httplib::Server& routes) {
   });
   AddMetricsRoute(routes, &metrics_, &auth_);
   AddDashboardRoutes(routes);
+  // Set before the HTTP port starts and reset after it stops: no handler sees it change.
+  AddJsonApi(routes, [this] { return gateway_channel_; });
 }
 
 absl::Status Daemon::PrepareUpdates() {
@@ -272,6 +282,7 @@ absl::Status Daemon::Stop() {
     server_->Shutdown(std::chrono::system_clock::now());
   }
   if (http_ != nullptr) http_->Stop();
+  gateway_channel_.reset();  // before the server it leads into
   blocking_.Stop();
   // A publication under way finishes (it is short and atomic in the log); queued updates are cancelled.
   if (operations_ != nullptr) operations_->Stop();

@@ -2,7 +2,8 @@
 // Stop() takes it down in reverse.
 //
 // Start: data directory (created, locked against a second daemon) → credentials → gRPC server listening, health NOT_SERVING
-// → HTTP port listening (server/http/: /readyz says 503 until serving) → store opened
+// → HTTP port listening (server/http/: /readyz says 503 until serving; server/gateway/: the JSON API, into the gRPC
+// server's in-process channel) → store opened
 // (recovery: every map's checkpoint, then its log) → health SERVING → update schedule. Calls that arrive during
 // recovery get UNAVAILABLE (server/rpc/store_handle.h).
 // Stop: update schedule stopped → health NOT_SERVING, /readyz 503, and new calls refused (UNAVAILABLE) → the calls in
@@ -83,6 +84,8 @@ class Daemon {
   std::vector<std::string> service_names_;  // for health: each service, and "" for the whole server
   std::unique_ptr<grpc::Server> server_;
   std::string address_;
+  // The JSON API's in-process channel into server_ (server/gateway/json_api.h).
+  std::shared_ptr<grpc::Channel> gateway_channel_;
   std::unique_ptr<HttpServer> http_;  // its handlers call into server_: stopped after it drains
   std::atomic<bool> serving_ = false;  // what health says, for /readyz
   std::atomic<bool> stopped_ = false;  // read by /readyz

@@ -3,16 +3,9 @@
 #include <optional>
 #include <string>
 
+#include "server/http/http_status.h"
+
 namespace fremen::server {
-
-namespace {
-
-// The HTTP status of an authorization refusal.
-int RefusalStatus(const absl::Status& status) {
-  return status.code() == absl::StatusCode::kPermissionDenied ? 403 : 401;
-}
-
-}  // namespace
 
 void AddMetricsRoute(httplib::Server& server, const Metrics* metrics, const Authenticator* auth) {
   server.Get("/metrics", [metrics, auth](const httplib::Request& request, httplib::Response& response) {
@@ -20,9 +13,7 @@ void AddMetricsRoute(httplib::Server& server, const Metrics* metrics, const Auth
     std::optional<absl::string_view> authorization;
     if (request.has_header("Authorization")) authorization = header;
     if (absl::Status denied = auth->AuthorizeHeader(authorization, Access::kRead, "/metrics"); !denied.ok()) {
-      response.status = RefusalStatus(denied);
-      if (response.status == 401) response.set_header("WWW-Authenticate", "Bearer");
-      response.set_content(std::string(denied.message()) + "\n", "text/plain");
+      SetErrorResponse(denied, response);  // as the JSON API's refusals
       return;
     }
     response.set_content(metrics->Scrape(), "text/plain; version=0.0.4; charset=utf-8");
