@@ -17,6 +17,7 @@ packages=(
   mypy python3-pycodestyle  # the Python package's type and style checks (python.mypy, python.pycodestyle)
   openssl  # the tests make their TLS certificates with it
   prometheus  # e2e.HttpPrometheusTest: a real Prometheus scrapes fremend's /metrics
+  nginx-light python3-yaml  # the fleet tests: a real nginx routes on x-fremen-map; the Kubernetes manifests parsed
 )
 case "${1:-}" in
   fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;  # libclang_rt.fuzzer, asan and ubsan for clang

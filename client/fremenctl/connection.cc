@@ -4,8 +4,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "client/fremenctl/exit_codes.h"
 
 namespace fremen::client {
@@ -43,10 +45,20 @@ void AddGlobalOptions(CLI::App& app) {
 
 CallOptions GlobalCall() { return CallOptions{.timeout = absl::Seconds(Globals().timeout_seconds)}; }
 
-Client ConnectOrExit(absl::string_view command) {
+std::vector<std::string> Addresses() {
+  std::vector<std::string> addresses;
+  for (absl::string_view a : absl::StrSplit(Globals().address, ',', absl::SkipWhitespace())) {
+    addresses.emplace_back(absl::StripAsciiWhitespace(a));
+  }
+  return addresses;
+}
+
+namespace {
+
+Client ConnectToOrExit(absl::string_view command, const std::string& address) {
   const GlobalOptions& g = Globals();
   ConnectionOptions options;
-  options.address = g.address;
+  options.address = address;
   options.token = g.token;
   options.default_timeout = absl::Seconds(g.timeout_seconds);
   // A person waits at the terminal: ride out a blip (the daemon restarting), but say soon that it
@@ -63,6 +75,26 @@ Client ConnectOrExit(absl::string_view command) {
   auto client = Client::Connect(std::move(options));
   if (!client.ok()) FailUsage(command, client.status().message());
   return *std::move(client);
+}
+
+}  // namespace
+
+Client ConnectOrExit(absl::string_view command) {
+  const std::vector<std::string> addresses = Addresses();
+  if (addresses.size() != 1) {
+    FailUsage(command, absl::StrCat("--address names ", addresses.size(),
+                                    " daemons; this command talks to one: a daemon, or the fleet's proxy"));
+  }
+  return ConnectToOrExit(command, addresses[0]);
+}
+
+std::vector<Daemon> ConnectEachOrExit(absl::string_view command, const std::vector<std::string>& addresses) {
+  std::vector<Daemon> daemons;
+  for (const std::string& address : addresses.empty() ? Addresses() : addresses) {
+    daemons.push_back({address, ConnectToOrExit(command, address)});
+  }
+  if (daemons.empty()) FailUsage(command, "--address names no daemon");
+  return daemons;
 }
 
 std::string HintFor(const absl::Status& status, absl::string_view map, absl::string_view address) {
@@ -86,11 +118,16 @@ std::string HintFor(const absl::Status& status, absl::string_view map, absl::str
   }
 }
 
-void FailCall(absl::string_view command, absl::string_view what, const absl::Status& status, absl::string_view map) {
+void ReportCall(absl::string_view command, absl::string_view address, absl::string_view what,
+                const absl::Status& status, absl::string_view map) {
   std::fprintf(stderr, "fremenctl %s: %s: %s\n", std::string(command).c_str(), std::string(what).c_str(),
                std::string(status.message()).c_str());
-  const std::string hint = HintFor(status, map, Globals().address);
+  const std::string hint = HintFor(status, map, address);
   if (!hint.empty()) std::fprintf(stderr, "  %s\n", hint.c_str());
+}
+
+void FailCall(absl::string_view command, absl::string_view what, const absl::Status& status, absl::string_view map) {
+  ReportCall(command, Globals().address, what, status, map);
   throw CLI::RuntimeError(kExitFailure);
 }
 
