@@ -50,7 +50,12 @@ TEST(PlacementTest, OwnersAreDeterministicAndIndependentOfTheDaemonsOrder) {
 TEST(PlacementTest, MatchesOwnersObservedThroughNginx) {
   const Placement fleet = Fleet({"127.0.0.1:50051", "127.0.0.1:50061", "127.0.0.1:50071"});
   const std::map<std::string, std::string> observed = {
-      // FILLED IN BELOW
+      {"m1", "127.0.0.1:50071"},          {"m2", "127.0.0.1:50071"},     {"m3", "127.0.0.1:50061"},
+      {"m4", "127.0.0.1:50061"},          {"m5", "127.0.0.1:50071"},     {"m6", "127.0.0.1:50051"},
+      {"m7", "127.0.0.1:50061"},          {"m8", "127.0.0.1:50071"},     {"m9", "127.0.0.1:50061"},
+      {"m10", "127.0.0.1:50061"},         {"m11", "127.0.0.1:50071"},    {"m12", "127.0.0.1:50061"},
+      {"office", "127.0.0.1:50051"},      {"lab", "127.0.0.1:50051"},    {"warehouse-7", "127.0.0.1:50051"},
+      {"hospital.wing-b", "127.0.0.1:50071"}, {"a", "127.0.0.1:50071"},
   };
   for (const auto& [map, owner] : observed) EXPECT_EQ(fleet.Owner(map), owner) << map;
 }
