@@ -13,6 +13,12 @@ daemon's HTTP address: literal IP daemons get one line each; daemons named by DN
 host in both addresses and the same two ports on every daemon (a StatefulSet's pods), which a
 single pattern then maps.
 
+--configmap NAME wraps the configuration in a Kubernetes ConfigMap NAME (key nginx.conf), as
+deploy/kubernetes/proxy-configmap.yaml is made:
+
+  render.py --configmap fremen-proxy --daemon fremend-0:50051=fremend-0:50052 ... \
+      > deploy/kubernetes/proxy-configmap.yaml
+
 --runtime-dir DIR puts the pid file, error log, access log and temporary files in DIR (a test's
 nginx, or any nginx run by a user that cannot write /var); without, they go to /tmp and the logs
 to stderr and stdout (a container).
@@ -116,6 +122,13 @@ def render(daemons, grpc_listen, http_listen, runtime_dir):
     return text
 
 
+def configmap(name, text, command):
+    """`text` as the key nginx.conf of a ConfigMap `name` (a YAML literal block)."""
+    body = "".join(f"    {line}\n" if line else "\n" for line in text.splitlines())
+    return (f"# Rendered by deploy/nginx/render.py; do not edit. Made with:\n#   {command}\n"
+            f"apiVersion: v1\nkind: ConfigMap\nmetadata:\n  name: {name}\ndata:\n  nginx.conf: |\n{body}")
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--daemon", action="append", default=[], metavar="GRPC[=HTTP]",
@@ -124,6 +137,7 @@ def main(argv):
     parser.add_argument("--http-listen", default="0.0.0.0:50052",
                         help="the proxy's HTTP address (empty: none)")
     parser.add_argument("--runtime-dir", default="", help="pid, logs and temporary files here")
+    parser.add_argument("--configmap", default="", metavar="NAME", help="as a Kubernetes ConfigMap NAME")
     parser.add_argument("--out", default="-", help="write here instead of stdout")
     args = parser.parse_args(argv)
     try:
@@ -131,6 +145,10 @@ def main(argv):
     except ValueError as e:
         print(f"render.py: {e}", file=sys.stderr)
         return 2
+    if args.configmap:
+        command = " ".join(["deploy/nginx/render.py", "--configmap", args.configmap]
+                           + [f"--daemon {d}" for d in args.daemon])
+        text = configmap(args.configmap, text, command)
     if args.out == "-":
         sys.stdout.write(text)
     else:
