@@ -166,15 +166,16 @@ class ProxyConfigTest(unittest.TestCase):
     @unittest.skipIf(NGINX is None, "nginx is not installed (scripts/install-deps.sh installs nginx-light)")
     def test_nginx_accepts_a_loopback_fleet_and_the_configmap(self):
         with tempfile.TemporaryDirectory() as tmp:
-            rendered = render("--runtime-dir", tmp, "--grpc-listen", "127.0.0.1:50081", "--http-listen", "127.0.0.1:50082",
-                              "--daemon", "127.0.0.1:50051=127.0.0.1:50052", "--daemon", "127.0.0.1:50061=127.0.0.1:50062")
+            rendered = render("--runtime-dir", tmp, "--grpc-listen", "127.0.0.1:50081",
+                              "--http-listen", "127.0.0.1:50082", "--daemon", "127.0.0.1:50051=127.0.0.1:50052",
+                              "--daemon", "127.0.0.1:50061=127.0.0.1:50062")
             self.assertEqual(rendered.returncode, 0, rendered.stderr)
             checked = nginx_test(rendered.stdout, tmp)
             self.assertEqual(checked.returncode, 0, checked.stderr)
             self.assertIn("test is successful", checked.stderr)
         with tempfile.TemporaryDirectory() as tmp:
-            # (nginx -t binds no port.) The cluster's names do not resolve here: the same text with loopback addresses, and
-            # the container's /tmp moved into the test's directory.
+            # The cluster's names do not resolve here: the same text with loopback addresses (nginx -t
+            # binds no port), and the container's /tmp moved into the test's directory.
             conf = one("ConfigMap", "fremen-proxy")["data"]["nginx.conf"]
             conf = re.sub(r"\bfremend-(\d+):", lambda m: f"127.0.0.{int(m.group(1)) + 1}:", conf)
             conf = conf.replace(" /tmp/", f" {tmp}/").replace("0.0.0.0:", "127.0.0.1:")
@@ -210,7 +211,7 @@ class EnvoyConfigTest(unittest.TestCase):
         self.assertEqual(self.hash_keys("fremend_grpc"), statefulset_daemons())
 
     def test_routes_hash_on_the_map(self):
-        listeners = {l["name"]: l for l in self.config["static_resources"]["listeners"]}
+        listeners = {x["name"]: x for x in self.config["static_resources"]["listeners"]}
         for name, cluster in (("grpc", "fremend_grpc"), ("http", "fremend_http")):
             manager = listeners[name]["filter_chains"][0]["filters"][0]["typed_config"]
             routes = manager["route_config"]["virtual_hosts"][0]["routes"]
@@ -225,17 +226,17 @@ class EnvoyConfigTest(unittest.TestCase):
 class DockerfileTest(unittest.TestCase):
     def test_two_debian_stages_a_non_root_user_and_a_health_check(self):
         with open(os.path.join(ROOT, "deploy", "Dockerfile")) as f:
-            lines = [l.strip() for l in f if l.strip() and not l.lstrip().startswith("#")]
-        stages = [l for l in lines if l.startswith("FROM ")]
+            lines = [line.strip() for line in f if line.strip() and not line.lstrip().startswith("#")]
+        stages = [line for line in lines if line.startswith("FROM ")]
         self.assertEqual(len(stages), 2)
         for stage in stages:
             self.assertRegex(stage, r"^FROM debian:12\b")
-        users = [l.split()[1] for l in lines if l.startswith("USER ")]
+        users = [line.split()[1] for line in lines if line.startswith("USER ")]
         self.assertTrue(users)
         self.assertNotIn(users[-1].split(":")[0], ("root", "0"))
-        self.assertTrue(any(l.startswith("HEALTHCHECK ") for l in lines))
-        self.assertTrue(any(l.startswith("ENTRYPOINT") and "fremend" in l for l in lines))
-        self.assertTrue(any("FREMEN_NATIVE" in l for l in lines))
+        self.assertTrue(any(line.startswith("HEALTHCHECK ") for line in lines))
+        self.assertTrue(any(line.startswith("ENTRYPOINT") and "fremend" in line for line in lines))
+        self.assertTrue(any("FREMEN_NATIVE" in line for line in lines))
 
 
 def kubectl_dry_run():

@@ -242,6 +242,19 @@ TEST_F(FleetRoutingTest, SixWritersThroughTheProxyLeaveEveryAcknowledgedObservat
           << map << " also on " << members_[d].grpc;
     }
   }
+
+  // The nightly job over the fleet: every map of every daemon updated, each where it is.
+  const RunResult update = Fremenctl({"update", "--all", "--wait", "--poll-interval", "0.05", "--address", AllDaemons()});
+  ASSERT_EQ(update.exit_code, 0) << update.out << update.err;
+  EXPECT_THAT(update.out, HasSubstr(absl::StrCat("update --all: ", kMaps, " maps on 3 daemons: ", kMaps,
+                                                 " updated, 0 failed")));
+  for (int i = 0; i < kMaps; ++i) {
+    const std::string map = MapName(i);
+    EXPECT_THAT(update.out, HasSubstr(absl::StrCat("(update of ", map, " on ", placement_->Owner(map), ")")));
+    auto stats = ClientOf(placement_->Owner(map), 4).GetMapStats(map);
+    ASSERT_TRUE(stats.ok()) << stats.status();
+    EXPECT_GT(stats->dynamic_states(), 0u) << map;
+  }
 }
 
 TEST_F(FleetRoutingTest, HttpRequestsReachTheDaemonThatHoldsTheMap) {
