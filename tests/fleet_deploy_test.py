@@ -110,7 +110,7 @@ class KubernetesManifestsTest(unittest.TestCase):
     def test_disruption_budgets_cover_the_daemons_and_the_proxy(self):
         budgets = {d["metadata"]["name"]: d for d in all_documents() if d["kind"] == "PodDisruptionBudget"}
         self.assertEqual(budgets["fremend"]["spec"]["maxUnavailable"], 1)
-        self.assertGreaterEqual(budgets["fremen-proxy"]["spec"]["minAvailable"], 1)
+        self.assertEqual(budgets["fremen-proxy"]["spec"]["maxUnavailable"], 1)
         for name, owner in (("fremend", one("StatefulSet", "fremend")), ("fremen-proxy", one("Deployment"))):
             labels = owner["spec"]["template"]["metadata"]["labels"]
             for key, value in budgets[name]["spec"]["selector"]["matchLabels"].items():
