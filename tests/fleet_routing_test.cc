@@ -272,7 +272,8 @@ TEST_F(FleetRoutingTest, HttpRequestsReachTheDaemonThatHoldsTheMap) {
     auto by_path = http.Get(absl::StrCat("/v1/maps/", map, "/stats"));
     ASSERT_TRUE(by_path) << httplib::to_string(by_path.error());
   }
-  const std::string log = proxy_->AccessLog();
+  // Its creation and two HTTP requests per map.
+  const std::string log = proxy_->AccessLog(3 * kMaps);
   for (int i = 0; i < kMaps; ++i) {
     const std::string map = MapName(i);
     EXPECT_THAT(log, HasSubstr(absl::StrCat("\"GET /v1/maps/", map, "/stats HTTP/1.1\" ")));

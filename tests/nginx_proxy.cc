@@ -1,17 +1,14 @@
 #include "tests/nginx_proxy.h"
 
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <netinet/in.h>
-#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include "absl/strings/numbers.h"
@@ -24,13 +21,6 @@ namespace fremen::testing {
 namespace {
 
 constexpr auto kStartTimeout = std::chrono::seconds(30);
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // Whether something accepts TCP connections at "127.0.0.1:PORT".
 bool Accepts(const std::string& address) {
@@ -89,30 +79,16 @@ absl::StatusOr<std::unique_ptr<NginxProxy>> NginxProxy::Start(const std::string&
   std::vector<std::string> args = NginxArgs(dir, *config);
   // One process in the foreground: killed with the test (PDEATHSIG), no worker left behind.
   args.insert(args.end(), {"-g", "daemon off; master_process off;"});
-  const std::string binary = NginxBinary();
-  std::vector<char*> argv = {const_cast<char*>(binary.c_str())};
-  for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
-  argv.push_back(nullptr);
   const std::string out_path = absl::StrCat(dir, "/nginx.out");
-  const pid_t pid = fork();
+  const pid_t pid = SpawnBackground(NginxBinary(), args, out_path);
   if (pid < 0) return absl::InternalError("fork failed");
-  if (pid == 0) {
-    prctl(PR_SET_PDEATHSIG, SIGKILL);
-    const int out = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (out < 0) _exit(126);
-    dup2(out, STDOUT_FILENO);
-    dup2(out, STDERR_FILENO);
-    close(out);
-    execv(binary.c_str(), argv.data());
-    _exit(127);
-  }
   std::unique_ptr<NginxProxy> proxy(new NginxProxy(pid, dir, grpc_address, http_address));
   const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
   while (!(Accepts(grpc_address) && Accepts(http_address))) {
     int status = 0;
     if (waitpid(pid, &status, WNOHANG) == pid) {
       proxy->pid_ = -1;
-      return absl::InternalError(absl::StrCat("nginx exited at start: ", ReadFile(out_path), proxy->ErrorLog()));
+      return absl::InternalError(absl::StrCat("nginx exited at start: ", ReadTextFile(out_path), proxy->ErrorLog()));
     }
     if (std::chrono::steady_clock::now() > deadline) {
       return absl::DeadlineExceededError(absl::StrCat("nginx does not accept connections: ", proxy->ErrorLog()));
@@ -129,7 +105,17 @@ NginxProxy::~NginxProxy() {
   waitpid(pid_, &status, 0);
 }
 
-std::string NginxProxy::AccessLog() const { return ReadFile(absl::StrCat(dir_, "/access.log")); }
-std::string NginxProxy::ErrorLog() const { return ReadFile(absl::StrCat(dir_, "/error.log")); }
+std::string NginxProxy::AccessLog(size_t lines) const {
+  const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+  for (;;) {
+    std::string log = ReadTextFile(absl::StrCat(dir_, "/access.log"));
+    if (static_cast<size_t>(std::count(log.begin(), log.end(), '\n')) >= lines ||
+        std::chrono::steady_clock::now() > deadline) {
+      return log;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+std::string NginxProxy::ErrorLog() const { return ReadTextFile(absl::StrCat(dir_, "/error.log")); }
 
 }  // namespace fremen::testing

@@ -43,8 +43,10 @@ class NginxProxy {
 
   const std::string& grpc_address() const { return grpc_address_; }
   const std::string& http_address() const { return http_address_; }
-  // nginx's access log so far: one line per request with map="..." and upstream=ADDRESS.
-  std::string AccessLog() const;
+  // nginx's access log once it has at least `lines` lines (nginx writes a request's line after its
+  // answer: the client can be faster), or after 30 s as it is: one line per request, with
+  // map="..." and upstream=ADDRESS.
+  std::string AccessLog(size_t lines = 0) const;
   // Its error log so far.
   std::string ErrorLog() const;
 
