@@ -244,7 +244,8 @@ TEST_F(FleetRoutingTest, SixWritersThroughTheProxyLeaveEveryAcknowledgedObservat
   }
 
   // The nightly job over the fleet: every map of every daemon updated, each where it is.
-  const RunResult update = Fremenctl({"update", "--all", "--wait", "--poll-interval", "0.05", "--address", AllDaemons()});
+  const RunResult update =
+      Fremenctl({"update", "--all", "--wait", "--poll-interval", "0.05", "--address", AllDaemons()});
   ASSERT_EQ(update.exit_code, 0) << update.out << update.err;
   EXPECT_THAT(update.out, HasSubstr(absl::StrCat("update --all: ", kMaps, " maps on 3 daemons: ", kMaps,
                                                  " updated, 0 failed")));
@@ -304,7 +305,8 @@ TEST_F(FleetRoutingTest, AKilledDaemonsMapsAreUnavailableThroughTheProxyUntilItI
     auto got = proxy_client_->GetMap(map);
     if (OwnerOf(map) == kVictim) {
       EXPECT_EQ(got.status().code(), absl::StatusCode::kUnavailable) << map << ": " << got.status();
-      EXPECT_THAT(got.status().message(), HasSubstr(absl::StrCat("the daemon that holds map ", map, " is unavailable")));
+      EXPECT_THAT(got.status().message(),
+                  HasSubstr(absl::StrCat("the daemon that holds map ", map, " is unavailable")));
       auto metrics = http.Get("/metrics", {{"x-fremen-map", map}});
       ASSERT_TRUE(metrics);
       EXPECT_EQ(metrics->status, 503) << map;
@@ -329,6 +331,29 @@ TEST_F(FleetRoutingTest, AKilledDaemonsMapsAreUnavailableThroughTheProxyUntilItI
     const int index = std::stoi(map.substr(map.size() - 2));
     EXPECT_EQ(stats->observations(), index % 3 == 0 ? 0u : 1u) << map;
   }
+}
+
+// What fremenctl refuses before it talks to anyone (exit 2, the message says what to fix).
+TEST(FleetCommandLineTest, RefusesAFleetWhereOneDaemonIsMeantAndBadPlacements) {
+  const auto run = [](const std::vector<std::string>& args) { return RunProgram(FREMENCTL_BINARY, args); };
+  RunResult r = run({"maps", "get", "lab", "--address", "127.0.0.1:1,127.0.0.1:2"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--address names 2 daemons; this command talks to one"));
+  r = run({"fleet", "placement", "--daemons", "a:1,b:2,a:1", "--map", "lab"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("\"a:1\" is listed twice"));
+  r = run({"fleet", "placement", "--daemons", "a:1,b:2", "--http", "a:3", "--map", "lab"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--http names 1 addresses for 2 daemons"));
+  r = run({"update"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--map M, or --all"));
+  EXPECT_EQ(run({"update", "--all", "--map", "lab"}).exit_code, 2);
+  // Offline placement with both addresses of the owner.
+  r = run({"fleet", "placement", "--daemons", "a:1,b:1", "--http", "a:2,b:2", "--map", "lab"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Placement fleet = *Placement::Create({"a:1", "b:1"});
+  EXPECT_THAT(r.out, HasSubstr(absl::StrCat("lab ", fleet.Owner("lab"), " ", fleet.Owner("lab").substr(0, 1), ":2\n")));
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -52,7 +53,10 @@ class NginxProxy {
 
  private:
   NginxProxy(pid_t pid, std::string dir, std::string grpc_address, std::string http_address)
-      : pid_(pid), dir_(std::move(dir)), grpc_address_(std::move(grpc_address)), http_address_(std::move(http_address)) {}
+      : pid_(pid),
+        dir_(std::move(dir)),
+        grpc_address_(std::move(grpc_address)),
+        http_address_(std::move(http_address)) {}
 
   pid_t pid_;
   const std::string dir_;

@@ -96,9 +96,11 @@ void RegisterFleetCommand(CLI::App& app) {
   CLI::App* placement = fleet->add_subcommand(
       "placement", "The daemon that owns each map, as the proxy's consistent hash on x-fremen-map places it");
   placement->add_option("--daemons", a->daemons,
-                        "the fleet's daemons, HOST:PORT,...: exactly the proxy's `server` strings (default: --address)");
+                        "the fleet's daemons, HOST:PORT,...: exactly the proxy's `server` strings "
+                        "(default: --address)");
   placement->add_option("--map", a->maps, "a map (may repeat); without, every map the daemons hold, asked of each");
-  placement->add_option("--http", a->http, "each daemon's HTTP address, in the order of --daemons: adds an HTTP column");
+  placement->add_option("--http", a->http,
+                        "each daemon's HTTP address, in the order of --daemons: adds an HTTP column");
   placement->footer(
       "Without --map, exit 1 when a map is held by a daemon that is not its owner (MISPLACED) or a daemon does not "
       "answer.\nThe names must be the proxy's server strings exactly: nginx hashes the string, port included "

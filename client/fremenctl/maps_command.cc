@@ -1,5 +1,6 @@
 // `fremenctl maps`: create (every setting of a map as an option), list (a table, page by page from
-// the daemon; of every daemon of a fleet with several --address), get (key: value lines or --json) and delete (only with --yes: it removes the data).
+// the daemon; of every daemon of a fleet with several --address), get (key: value lines or
+// --json) and delete (only with --yes: it removes the data).
 #include "client/fremenctl/maps_command.h"
 
 #include <algorithm>

@@ -34,7 +34,9 @@ uLong Update(uLong crc, absl::string_view bytes) {
 
 }  // namespace
 
-uint32_t Placement::Crc32(absl::string_view bytes) { return static_cast<uint32_t>(Update(crc32(0, nullptr, 0), bytes)); }
+uint32_t Placement::Crc32(absl::string_view bytes) {
+  return static_cast<uint32_t>(Update(crc32(0, nullptr, 0), bytes));
+}
 
 absl::StatusOr<Placement> Placement::Create(std::vector<std::string> daemons) {
   if (daemons.empty()) return absl::InvalidArgumentError("a fleet needs at least one daemon");
