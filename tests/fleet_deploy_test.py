@@ -141,7 +141,10 @@ class KubernetesManifestsTest(unittest.TestCase):
         command = container["command"] + container["args"]
         self.assertEqual(command[:4], ["fremenctl", "update", "--all", "--wait"])
         address = next(a for a in command if a.startswith("--address="))[len("--address="):]
-        self.assertEqual(address.split(","), [f"{d}.fremend:50051" for d in statefulset_daemons()])
+        # Every pod: through the headless Service (which publishes pods not yet ready too).
+        headless = one("Service", one("StatefulSet")["spec"]["serviceName"])
+        self.assertEqual(address, f"all:{headless['metadata']['name']}:50051")
+        self.assertTrue(headless["spec"]["publishNotReadyAddresses"])
         # The daemons' own schedules are off, or each map would be updated twice a night.
         sts_container = one("StatefulSet")["spec"]["template"]["spec"]["containers"][0]
         self.assertIn("--update-schedule=", sts_container["args"])

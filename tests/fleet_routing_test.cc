@@ -8,6 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -168,6 +169,14 @@ TEST_F(FleetRoutingTest, MapsCreatedThroughTheProxyLandOnTheirPredictedOwners) {
     EXPECT_EQ(columns[0], MapName(i));
     EXPECT_EQ(columns[1], placement_->Owner(MapName(i)));
   }
+  // all:HOST:PORT, every address HOST resolves to (one here), is a fleet too.
+  const RunResult every = Fremenctl({"maps", "list", "--address", absl::StrCat("all:", members_[0].grpc)});
+  ASSERT_EQ(every.exit_code, 0) << every.err;
+  EXPECT_THAT(every.out, HasSubstr("DAEMON"));
+  EXPECT_EQ(std::count(every.out.begin(), every.out.end(), '\n'), static_cast<long>(held[0].size() + 1)) << every.out;
+  const RunResult unresolved = Fremenctl({"status", "--address", "all:no-such-daemon.invalid:50051"});
+  EXPECT_EQ(unresolved.exit_code, 1);
+  EXPECT_THAT(unresolved.err, HasSubstr("cannot resolve no-such-daemon.invalid"));
   const RunResult status = Fremenctl({"status", "--address", AllDaemons()});
   ASSERT_EQ(status.exit_code, 0) << status.err;
   for (int d = 0; d < kDaemons; ++d) {
@@ -339,6 +348,10 @@ TEST(FleetCommandLineTest, RefusesAFleetWhereOneDaemonIsMeantAndBadPlacements) {
   RunResult r = run({"maps", "get", "lab", "--address", "127.0.0.1:1,127.0.0.1:2"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("--address names 2 daemons; this command talks to one"));
+  EXPECT_EQ(run({"maps", "get", "lab", "--address", "all:localhost:1"}).exit_code, 2);
+  r = run({"fleet", "placement", "--address", "all:fremend:50051", "--map", "lab"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("name the daemons one by one"));
   r = run({"fleet", "placement", "--daemons", "a:1,b:2,a:1", "--map", "lab"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("\"a:1\" is listed twice"));

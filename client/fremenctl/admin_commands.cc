@@ -140,7 +140,7 @@ void RegisterStatusCommand(CLI::App& app) {
                  "daemon,\n{\"daemon\": ..., \"status\": ...}); exit 1 when one does not answer.");
   status->callback([json] {
     int unreachable = 0;
-    const bool fleet = Addresses().size() > 1;
+    const bool fleet = NamesAFleet();
     for (const Daemon& daemon : ConnectEachOrExit("status")) {
       auto s = daemon.client.GetServerStatus(GlobalCall());
       if (!s.ok()) {

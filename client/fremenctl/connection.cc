@@ -1,7 +1,13 @@
 #include "client/fremenctl/connection.h"
 
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "absl/strings/ascii.h"
@@ -53,6 +59,40 @@ std::vector<std::string> Addresses() {
   return addresses;
 }
 
+bool NamesAFleet() {
+  const std::vector<std::string> addresses = Addresses();
+  return addresses.size() > 1 ||
+         (addresses.size() == 1 && absl::StartsWith(addresses[0], kEveryAddressPrefix));
+}
+
+absl::StatusOr<std::vector<std::string>> ResolveEvery(absl::string_view host_port) {
+  const size_t colon = host_port.rfind(':');
+  if (colon == absl::string_view::npos || colon == 0) {
+    return absl::InvalidArgumentError(absl::StrCat("all:", host_port, ": expected all:HOST:PORT"));
+  }
+  const std::string host(host_port.substr(0, colon)), port(host_port.substr(colon + 1));
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (const int error = getaddrinfo(host.c_str(), port.c_str(), &hints, &found); error != 0) {
+    return absl::UnavailableError(absl::StrCat("cannot resolve ", host, ": ", gai_strerror(error)));
+  }
+  std::set<std::string> addresses;
+  for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
+    char text[INET6_ADDRSTRLEN] = {};
+    if (a->ai_family == AF_INET) {
+      inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(a->ai_addr)->sin_addr, text, sizeof text);
+      addresses.insert(absl::StrCat(text, ":", port));
+    } else if (a->ai_family == AF_INET6) {
+      inet_ntop(AF_INET6, &reinterpret_cast<const sockaddr_in6*>(a->ai_addr)->sin6_addr, text, sizeof text);
+      addresses.insert(absl::StrCat("[", text, "]:", port));
+    }
+  }
+  freeaddrinfo(found);
+  return std::vector<std::string>(addresses.begin(), addresses.end());
+}
+
 namespace {
 
 Client ConnectToOrExit(absl::string_view command, const std::string& address) {
@@ -81,7 +121,7 @@ Client ConnectToOrExit(absl::string_view command, const std::string& address) {
 
 Client ConnectOrExit(absl::string_view command) {
   const std::vector<std::string> addresses = Addresses();
-  if (addresses.size() != 1) {
+  if (NamesAFleet() || addresses.empty()) {
     FailUsage(command, absl::StrCat("--address names ", addresses.size(),
                                     " daemons; this command talks to one: a daemon, or the fleet's proxy"));
   }
@@ -91,7 +131,13 @@ Client ConnectOrExit(absl::string_view command) {
 std::vector<Daemon> ConnectEachOrExit(absl::string_view command, const std::vector<std::string>& addresses) {
   std::vector<Daemon> daemons;
   for (const std::string& address : addresses.empty() ? Addresses() : addresses) {
-    daemons.push_back({address, ConnectToOrExit(command, address)});
+    if (!absl::StartsWith(address, kEveryAddressPrefix)) {
+      daemons.push_back({address, ConnectToOrExit(command, address)});
+      continue;
+    }
+    auto every = ResolveEvery(address.substr(kEveryAddressPrefix.size()));
+    if (!every.ok()) FailCall(command, address, every.status());
+    for (const std::string& resolved : *every) daemons.push_back({resolved, ConnectToOrExit(command, resolved)});
   }
   if (daemons.empty()) FailUsage(command, "--address names no daemon");
   return daemons;

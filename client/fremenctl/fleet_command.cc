@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "client/fremenctl/connection.h"
@@ -46,6 +47,12 @@ std::vector<std::string> SplitList(const std::string& list) {
 void RunPlacement(const PlacementArgs& a) {
   const std::string command = "fleet placement";
   const std::vector<std::string> names = a.daemons.empty() ? Addresses() : SplitList(a.daemons);
+  for (const std::string& name : names) {
+    if (absl::StartsWith(name, kEveryAddressPrefix)) {
+      FailUsage(command,
+                absl::StrCat("placement hashes the proxy's server strings: name the daemons one by one, not ", name));
+    }
+  }
   auto placement = Placement::Create(names);
   if (!placement.ok()) FailUsage(command, absl::StrCat("--daemons: ", placement.status().message()));
   const std::vector<std::string> http = SplitList(a.http);

@@ -187,7 +187,7 @@ void RegisterList(CLI::App& maps) {
   list->footer("With several daemons (--address A,B,C) every daemon is asked: the maps of all of them, with a DAEMON "
                "column;\nexit 1 when one does not answer (the others are listed).");
   list->callback([json] {
-    if (Addresses().size() > 1) return ListFleet(*json);
+    if (NamesAFleet()) return ListFleet(*json);
     Client client = ConnectOrExit("maps list");
     auto all = client.ListAllMaps(GlobalCall());
     if (!all.ok()) FailCall("maps list", "listing maps", all.status());
