@@ -107,7 +107,7 @@ void RegisterUpdateCommand(CLI::App& app) {
   update->footer(
       "While an update of the map runs, a new request joins it: `fremenctl update --map M --wait` follows the "
       "running job.\nFor a nightly cron: fremenctl update --map M --wait || alert\n"
-      "For a fleet's nightly CronJob: fremenctl update --all --wait --address fremend-0.fremend:50051,... || alert");
+      "For a fleet's nightly CronJob: fremenctl update --all --wait --address all:fremend:50051 || alert");
   update->callback([a] {
     if (a->all) return RunUpdateAll(*a);
     if (a->map.empty()) FailUsage("update", "name the map with --map M, or --all for every map");
