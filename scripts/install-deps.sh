@@ -20,6 +20,7 @@ packages=(
   prometheus  # e2e.HttpPrometheusTest: a real Prometheus scrapes fremend's /metrics
   libjs-chart.js  # Chart.js, embedded in fremend's dashboard at build time (docs/http.md, "Dashboard")
   chromium chromium-driver python3-selenium  # e2e.dashboard_browser: the dashboard in a real, headless browser
+  nginx-light python3-yaml  # the fleet tests: a real nginx routes on x-fremen-map; the Kubernetes manifests parsed
 )
 case "${1:-}" in
   fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;  # libclang_rt.fuzzer, asan and ubsan for clang

@@ -1,11 +1,9 @@
 #include "tests/fremend_fixture.h"
 
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <stdlib.h>
-#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -30,34 +28,6 @@ using Clock = std::chrono::steady_clock;
 constexpr auto kStartTimeout = std::chrono::seconds(60);
 constexpr auto kStopTimeout = std::chrono::seconds(60);
 constexpr auto kPollInterval = std::chrono::milliseconds(20);
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// Forks and execs fremend with its output to `log_path`; the child's pid.
-pid_t Spawn(const std::vector<std::string>& args, const std::string& log_path) {
-  std::vector<char*> argv;
-  argv.push_back(const_cast<char*>(FREMEND_BINARY));
-  for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    // A test that crashes must not leave its daemon running.
-    prctl(PR_SET_PDEATHSIG, SIGKILL);
-    const int log = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (log < 0) _exit(126);
-    dup2(log, STDOUT_FILENO);
-    dup2(log, STDERR_FILENO);
-    close(log);
-    execv(FREMEND_BINARY, argv.data());
-    _exit(127);
-  }
-  return pid;
-}
 
 // The exit code of a waitpid status; -1 for a signal.
 int ExitCodeOf(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
@@ -87,7 +57,7 @@ std::optional<TestCertificate> MakeTestCertificate(const TempDir& dir) {
                               " -subj /CN=localhost -addext subjectAltName=IP:127.0.0.1,DNS:localhost"
                               " -keyout '" + made.key_path + "' -out '" + made.cert_path + "' >/dev/null 2>&1";
   if (std::system(openssl.c_str()) != 0) return std::nullopt;
-  made.cert_pem = ReadFile(made.cert_path);
+  made.cert_pem = ReadTextFile(made.cert_path);
   return made;
 }
 
@@ -111,7 +81,7 @@ absl::StatusOr<std::unique_ptr<FremendProcess>> FremendProcess::Start(
   // The log sits beside the data directory, so that it survives the daemon for the test to read.
   static int starts = 0;
   const std::string log_path = absl::StrCat(data_dir, ".fremend-", getpid(), "-", ++starts, ".log");
-  const pid_t pid = Spawn(all_args, log_path);
+  const pid_t pid = SpawnBackground(FREMEND_BINARY, all_args, log_path);
   if (pid < 0) return absl::InternalError("fork failed");
   std::unique_ptr<FremendProcess> process(new FremendProcess(pid, log_path, std::move(credentials)));
   if (absl::Status serving = process->AwaitServing(); !serving.ok()) {
@@ -192,7 +162,7 @@ void FremendProcess::Kill() {
   Reap(true);
 }
 
-std::string FremendProcess::Log() const { return ReadFile(log_path_); }
+std::string FremendProcess::Log() const { return ReadTextFile(log_path_); }
 
 std::unique_ptr<grpc::ClientContext> CallContext(const std::vector<std::pair<std::string, std::string>>& metadata,
                                                  std::chrono::seconds deadline) {

@@ -9,7 +9,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fstream>
 #include <map>
+#include <sstream>
 
 #include "absl/strings/str_cat.h"
 
@@ -153,6 +155,33 @@ std::string Describe(const RunResult& result) {
   if (result.timed_out) return "timed out";
   if (result.signal != 0) return absl::StrCat("killed by signal ", result.signal);
   return absl::StrCat("exit code ", result.exit_code);
+}
+
+pid_t SpawnBackground(const std::string& binary, const std::vector<std::string>& args,
+                      const std::string& output_path) {
+  std::vector<std::string> argv_strings = {binary};
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  std::vector<char*> argv = Pointers(argv_strings);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // A test that crashes must not leave its daemon running.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    const int out = open(output_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (out < 0) _exit(126);
+    dup2(out, STDOUT_FILENO);
+    dup2(out, STDERR_FILENO);
+    close(out);
+    execv(binary.c_str(), argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+std::string ReadTextFile(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 }  // namespace fremen::testing

@@ -4,6 +4,8 @@
 // of hanging ctest.
 #pragma once
 
+#include <sys/types.h>
+
 #include <chrono>
 #include <string>
 #include <utility>
@@ -38,5 +40,15 @@ RunResult RunProgram(const std::string& binary, const std::vector<std::string>& 
 
 // "exit code 3", "killed by signal 9", "timed out": for test failure messages.
 std::string Describe(const RunResult& result);
+
+// Starts `binary` (a path) with `args` in the background — a daemon the test talks to — with stdout
+// and stderr to `output_path` (truncated). The child is killed (SIGKILL) when the test process
+// dies, even by a crash. Its pid (the caller waits for it), or -1 when fork fails; a program that
+// cannot be started exits with 127.
+pid_t SpawnBackground(const std::string& binary, const std::vector<std::string>& args,
+                      const std::string& output_path);
+
+// The whole text of a file ("" when it cannot be read): a log a test inspects.
+std::string ReadTextFile(const std::string& path);
 
 }  // namespace fremen::testing

@@ -8,6 +8,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "client/fremenctl/connection.h"
+#include "client/fremenctl/exit_codes.h"
 #include "client/fremenctl/print.h"
 
 namespace fremen::client {
@@ -80,58 +81,83 @@ void RegisterRestoreCommand(CLI::App& app) {
   });
 }
 
+namespace {
+
+// The status of the daemon at `address`, as lines for people.
+void PrintStatus(const std::string& address, const v1::GetServerStatusResponse& s) {
+  std::printf("fremend %s at %s, up %.0f s (since %s)\n", s.version().c_str(), address.c_str(),
+              s.uptime_seconds(), FormatTimestamp(s.start_time()).c_str());
+  std::printf("store: %s\n", s.store_state() == v1::STORE_STATE_OPEN ? "open" : "recovering");
+  std::printf("maps: %llu, states: %llu (%llu dynamic)\n", static_cast<unsigned long long>(s.map_count()),
+              static_cast<unsigned long long>(s.state_count()),
+              static_cast<unsigned long long>(s.dynamic_state_count()));
+  std::printf("free space: %s\n", FormatBytes(s.data_dir_free_bytes()).c_str());
+  std::printf("security: %s, %s\n", s.tls() ? "TLS" : "no TLS",
+              s.tokens_required() ? "tokens required" : "no tokens");
+  if (s.update_schedule().empty()) {
+    std::printf("update schedule: none\n");
+  } else {
+    std::printf("update schedule: %s (%s), next %s\n", s.update_schedule().c_str(), s.update_time_zone().c_str(),
+                FormatTimestamp(s.next_update_time()).c_str());
+  }
+  std::printf("running operations: %u\n", s.running_operations());
+  for (const v1::MapFault& fault : s.failed_maps()) {
+    std::printf("failed map %s: %s\n", fault.map().c_str(), fault.error().c_str());
+  }
+  for (const std::string& dir : s.unknown_directories()) {
+    std::printf("unknown directory (no catalog record names it; left for an operator): %s\n", dir.c_str());
+  }
+  if (s.has_next_scrub_time()) {
+    std::printf("background scrub: next pass %s\n", FormatTimestamp(s.next_scrub_time()).c_str());
+  }
+  for (const v1::MapScrub& scrub : s.map_scrubs()) {
+    if (scrub.clean()) {
+      std::printf("scrub of %s: %s, clean (%llu records)\n", scrub.map().c_str(),
+                  FormatTimestamp(scrub.finish_time()).c_str(), static_cast<unsigned long long>(scrub.records()));
+      continue;
+    }
+    std::printf("scrub of %s: %s, %llu PROBLEMS (fremenctl check %s lists them all)\n", scrub.map().c_str(),
+                FormatTimestamp(scrub.finish_time()).c_str(), static_cast<unsigned long long>(scrub.problem_count()),
+                scrub.map().c_str());
+    for (const v1::CheckProblem& p : scrub.problems()) {
+      std::printf("  %s\n", FormatCheckProblem(p).c_str());
+    }
+  }
+  for (const v1::Operation& op : s.last_updates()) {
+    std::printf("last update of %s: %s, %s\n", op.map().c_str(), FormatTimestamp(op.end_time()).c_str(),
+                op.error().code() == 0 ? absl::StrCat(op.update().states_published(), " states published").c_str()
+                                       : absl::StrCat("failed: ", op.error().message()).c_str());
+  }
+}
+
+}  // namespace
+
 void RegisterStatusCommand(CLI::App& app) {
   auto json = std::make_shared<bool>(false);
   CLI::App* status = app.add_subcommand("status", "The daemon's version, uptime, maps, schedule, last updates and scrubs");
   status->add_flag("--json", *json, "as JSON");
+  status->footer("With several daemons (--address A,B,C): each daemon's status in turn (--json: one object per "
+                 "daemon,\n{\"daemon\": ..., \"status\": ...}); exit 1 when one does not answer.");
   status->callback([json] {
-    Client client = ConnectOrExit("status");
-    auto s = client.GetServerStatus(GlobalCall());
-    if (!s.ok()) FailCall("status", Globals().address, s.status());
-    if (*json) return PrintJson(*s);
-    std::printf("fremend %s at %s, up %.0f s (since %s)\n", s->version().c_str(), Globals().address.c_str(),
-                s->uptime_seconds(), FormatTimestamp(s->start_time()).c_str());
-    std::printf("store: %s\n", s->store_state() == v1::STORE_STATE_OPEN ? "open" : "recovering");
-    std::printf("maps: %llu, states: %llu (%llu dynamic)\n", static_cast<unsigned long long>(s->map_count()),
-                static_cast<unsigned long long>(s->state_count()),
-                static_cast<unsigned long long>(s->dynamic_state_count()));
-    std::printf("free space: %s\n", FormatBytes(s->data_dir_free_bytes()).c_str());
-    std::printf("security: %s, %s\n", s->tls() ? "TLS" : "no TLS",
-                s->tokens_required() ? "tokens required" : "no tokens");
-    if (s->update_schedule().empty()) {
-      std::printf("update schedule: none\n");
-    } else {
-      std::printf("update schedule: %s (%s), next %s\n", s->update_schedule().c_str(), s->update_time_zone().c_str(),
-                  FormatTimestamp(s->next_update_time()).c_str());
-    }
-    std::printf("running operations: %u\n", s->running_operations());
-    for (const v1::MapFault& fault : s->failed_maps()) {
-      std::printf("failed map %s: %s\n", fault.map().c_str(), fault.error().c_str());
-    }
-    for (const std::string& dir : s->unknown_directories()) {
-      std::printf("unknown directory (no catalog record names it; left for an operator): %s\n", dir.c_str());
-    }
-    if (s->has_next_scrub_time()) {
-      std::printf("background scrub: next pass %s\n", FormatTimestamp(s->next_scrub_time()).c_str());
-    }
-    for (const v1::MapScrub& scrub : s->map_scrubs()) {
-      if (scrub.clean()) {
-        std::printf("scrub of %s: %s, clean (%llu records)\n", scrub.map().c_str(),
-                    FormatTimestamp(scrub.finish_time()).c_str(), static_cast<unsigned long long>(scrub.records()));
+    int unreachable = 0;
+    const bool fleet = NamesAFleet();
+    for (const Daemon& daemon : ConnectEachOrExit("status")) {
+      auto s = daemon.client.GetServerStatus(GlobalCall());
+      if (!s.ok()) {
+        ReportCall("status", daemon.address, daemon.address, s.status());
+        ++unreachable;
         continue;
       }
-      std::printf("scrub of %s: %s, %llu PROBLEMS (fremenctl check %s lists them all)\n", scrub.map().c_str(),
-                  FormatTimestamp(scrub.finish_time()).c_str(), static_cast<unsigned long long>(scrub.problem_count()),
-                  scrub.map().c_str());
-      for (const v1::CheckProblem& p : scrub.problems()) {
-        std::printf("  %s\n", FormatCheckProblem(p).c_str());
+      if (*json && fleet) {
+        std::printf("{\"daemon\":\"%s\",\"status\":%s}\n", daemon.address.c_str(), JsonOf(*s).c_str());
+      } else if (*json) {
+        PrintJson(*s);
+      } else {
+        if (fleet) std::printf("== %s\n", daemon.address.c_str());
+        PrintStatus(daemon.address, *s);
       }
     }
-    for (const v1::Operation& op : s->last_updates()) {
-      std::printf("last update of %s: %s, %s\n", op.map().c_str(), FormatTimestamp(op.end_time()).c_str(),
-                  op.error().code() == 0 ? absl::StrCat(op.update().states_published(), " states published").c_str()
-                                         : absl::StrCat("failed: ", op.error().message()).c_str());
-    }
+    if (unreachable > 0) throw CLI::RuntimeError(kExitFailure);
   });
 }
 

@@ -9,9 +9,11 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "absl/time/time.h"
 #include "client/lib/client.h"
@@ -19,6 +21,9 @@
 namespace fremen::client {
 
 struct GlobalOptions {
+  // One HOST:PORT, or several separated by commas: the daemons of a fleet, for the commands that
+  // look at all of them (maps list, status, update --all, fleet placement). all:HOST:PORT stands
+  // for every address HOST resolves to (a Kubernetes headless Service names every pod so).
   std::string address = "127.0.0.1:50051";
   std::string token;
   // PEM file of the root certificates that sign fremend's certificate; set = use TLS.
@@ -34,8 +39,26 @@ const GlobalOptions& Globals();
 // --address host:port`).
 void AddGlobalOptions(CLI::App& app);
 
-// A client for the global options. On bad options (an unreadable --tls-ca) reports and exits.
+// The addresses of --address, in order, as written (all:HOST:PORT not resolved).
+std::vector<std::string> Addresses();
+// Whether --address names a fleet: several addresses, or an all:HOST:PORT.
+bool NamesAFleet();
+inline constexpr absl::string_view kEveryAddressPrefix = "all:";
+// Every address HOST resolves to, as "IP:PORT" ("[IPv6]:PORT"), sorted; `host_port` is HOST:PORT.
+absl::StatusOr<std::vector<std::string>> ResolveEvery(absl::string_view host_port);
+
+// A client for the global options. On bad options (an unreadable --tls-ca) reports and exits; so
+// does a --address naming several daemons (this command talks to one: a daemon or the proxy).
 Client ConnectOrExit(absl::string_view command);
+
+// One daemon of a fleet and a client to it.
+struct Daemon {
+  std::string address;
+  Client client;
+};
+// A client per address of --address (or of `addresses` when not empty; all:HOST:PORT resolved,
+// exit 1 when that fails), each with the global options' token, TLS and timeout.
+std::vector<Daemon> ConnectEachOrExit(absl::string_view command, const std::vector<std::string>& addresses = {});
 
 // The per-call options of the global --timeout.
 CallOptions GlobalCall();
@@ -45,6 +68,10 @@ CallOptions GlobalCall();
 // was about: NOT_FOUND then says that it does not exist.
 [[noreturn]] void FailCall(absl::string_view command, absl::string_view what, const absl::Status& status,
                            absl::string_view map = "");
+// The same report without ending the command (a fleet command goes on with the other daemons);
+// `address` is the daemon the call went to.
+void ReportCall(absl::string_view command, absl::string_view address, absl::string_view what,
+                const absl::Status& status, absl::string_view map = "");
 // Reports a bad command line (an argument that CLI11 cannot check alone) and ends with kExitUsage.
 [[noreturn]] void FailUsage(absl::string_view command, absl::string_view message);
 

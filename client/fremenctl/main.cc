@@ -9,6 +9,7 @@
 #include "client/fremenctl/demo_command.h"
 #include "client/fremenctl/eval_command.h"
 #include "client/fremenctl/exit_codes.h"
+#include "client/fremenctl/fleet_command.h"
 #include "client/fremenctl/ingest_command.h"
 #include "client/fremenctl/maps_command.h"
 #include "client/fremenctl/model_command.h"
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
   fremen::client::RegisterModelCommand(app);
   fremen::client::RegisterDemoCommand(app);
   fremen::client::RegisterBenchCommand(app);
+  fremen::client::RegisterFleetCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {

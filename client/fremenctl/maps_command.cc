@@ -1,17 +1,23 @@
 // `fremenctl maps`: create (every setting of a map as an option), list (a table, page by page from
-// the daemon), get (key: value lines or --json) and delete (only with --yes: it removes the data).
+// the daemon; of every daemon of a fleet with several --address), get (key: value lines or
+// --json) and delete (only with --yes: it removes the data).
 #include "client/fremenctl/maps_command.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "client/fremenctl/connection.h"
+#include "client/fremenctl/exit_codes.h"
+#include "client/fremenctl/fleet_maps.h"
 #include "client/fremenctl/print.h"
 
 namespace fremen::client {
@@ -152,11 +158,36 @@ void RegisterCreate(CLI::App& maps) {
   });
 }
 
+// `maps list --address A,B,C`: every daemon's maps, merged in name order.
+void ListFleet(bool json) {
+  const FleetMaps fleet = ListEachDaemon("maps list", ConnectEachOrExit("maps list"));
+  std::vector<std::pair<const v1::Map*, const std::string*>> rows;
+  for (const DaemonMaps& daemon : fleet.daemons) {
+    for (const v1::Map& map : daemon.maps) rows.emplace_back(&map, &daemon.address);
+  }
+  std::sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.first->name(), *a.second) < std::tie(b.first->name(), *b.second);
+  });
+  if (!json) std::printf("%-32s %-28s %-40s %s\n", "NAME", "DAEMON", "SHAPE", "CREATED");
+  for (const auto& [map, daemon] : rows) {
+    if (json) {
+      std::printf("{\"daemon\":\"%s\",\"map\":%s}\n", daemon->c_str(), JsonOf(*map).c_str());
+    } else {
+      std::printf("%-32s %-28s %-40s %s\n", map->name().c_str(), daemon->c_str(), Shape(*map).c_str(),
+                  FormatTimestamp(map->create_time()).c_str());
+    }
+  }
+  if (fleet.unreachable > 0) throw CLI::RuntimeError(kExitFailure);
+}
+
 void RegisterList(CLI::App& maps) {
   auto json = std::make_shared<bool>(false);
   CLI::App* list = maps.add_subcommand("list", "List the maps, in name order");
   list->add_flag("--json", *json, "one JSON object per map");
+  list->footer("With several daemons (--address A,B,C) every daemon is asked: the maps of all of them, with a DAEMON "
+               "column;\nexit 1 when one does not answer (the others are listed).");
   list->callback([json] {
+    if (NamesAFleet()) return ListFleet(*json);
     Client client = ConnectOrExit("maps list");
     auto all = client.ListAllMaps(GlobalCall());
     if (!all.ok()) FailCall("maps list", "listing maps", all.status());

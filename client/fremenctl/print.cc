@@ -9,14 +9,16 @@
 
 namespace fremen::client {
 
-void PrintJson(const google::protobuf::Message& message) {
+void PrintJson(const google::protobuf::Message& message) { std::printf("%s\n", JsonOf(message).c_str()); }
+
+std::string JsonOf(const google::protobuf::Message& message) {
   google::protobuf::util::JsonPrintOptions options;
   options.always_print_primitive_fields = true;
   options.preserve_proto_field_names = true;
   std::string json;
   // Our messages always convert; a failure would be a bug worth seeing rather than empty output.
   if (!google::protobuf::util::MessageToJsonString(message, &json, options).ok()) json = "{}";
-  std::printf("%s\n", json.c_str());
+  return json;
 }
 
 std::string FormatTimestamp(const google::protobuf::Timestamp& timestamp) {

@@ -12,6 +12,8 @@ namespace fremen::client {
 
 // The message as one JSON object (fields with default values included), and a newline.
 void PrintJson(const google::protobuf::Message& message);
+// The same object as a string, without the newline (to nest it: {"daemon": ..., "map": ...}).
+std::string JsonOf(const google::protobuf::Message& message);
 // "2026-11-22T03:04:05Z"; "-" when unset.
 std::string FormatTimestamp(const google::protobuf::Timestamp& timestamp);
 // 1536 → "1.5 KiB".

@@ -3,10 +3,14 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "client/fremenctl/connection.h"
+#include "client/fremenctl/exit_codes.h"
+#include "client/fremenctl/fleet_maps.h"
 #include "client/fremenctl/operation_follow.h"
+#include "client/fremenctl/progress.h"
 
 namespace fremen::client {
 
@@ -14,6 +18,7 @@ namespace {
 
 struct UpdateArgs {
   std::string map;
+  bool all = false;
   bool wait = false;
   FollowArgs follow;
 };
@@ -30,20 +35,84 @@ void RunUpdate(const UpdateArgs& a) {
   FollowOperation(client, "update", a.map, op->name(), a.follow.options());
 }
 
+// `update --all`: the job on every map of every daemon of --address (for a nightly CronJob over a
+// fleet). All are started first — each daemon queues its own — then, with --wait, followed to
+// their ends one line each. A map that fails does not stop the others; the exit code says whether
+// any failed, or a daemon did not answer.
+void RunUpdateAll(const UpdateArgs& a) {
+  const std::string command = "update --all";
+  const std::vector<Daemon> daemons = ConnectEachOrExit(command);
+  const FleetMaps fleet = ListEachDaemon(command, daemons);
+  struct Started {
+    const Daemon* daemon;
+    v1::Operation op;
+  };
+  std::vector<Started> started;
+  int failed = fleet.unreachable;
+  size_t maps = 0;
+  for (const DaemonMaps& held : fleet.daemons) {
+    const Daemon* daemon = nullptr;
+    for (const Daemon& d : daemons) {
+      if (d.address == held.address) daemon = &d;
+    }
+    for (const v1::Map& map : held.maps) {
+      ++maps;
+      auto op = daemon->client.RunUpdate(map.name(), GlobalCall());
+      if (!op.ok()) {
+        ReportCall(command, held.address, absl::StrCat("map ", map.name(), " on ", held.address), op.status(),
+                   map.name());
+        ++failed;
+        continue;
+      }
+      std::printf("started %s (update of %s on %s)\n", op->name().c_str(), map.name().c_str(), held.address.c_str());
+      started.push_back({daemon, *std::move(op)});
+    }
+  }
+  std::fflush(stdout);
+  size_t succeeded = started.size();
+  if (a.wait) {
+    succeeded = 0;
+    WaitOptions wait;
+    wait.poll_interval = a.follow.options().poll_interval;
+    for (const Started& s : started) {
+      auto done = s.daemon->client.WaitOperation(s.op.map(), s.op.name(), wait, GlobalCall());
+      if (!done.ok()) {
+        ReportCall(command, s.daemon->address, absl::StrCat("following ", s.op.name()), done.status(), s.op.map());
+        ++failed;
+        continue;
+      }
+      done->error().code() == 0 ? ++succeeded : ++failed;
+      std::printf("%s: %s\n", s.daemon->address.c_str(), OperationLine(*done).c_str());
+      std::fflush(stdout);
+    }
+  }
+  std::printf("%s: %zu maps on %zu daemons: %zu %s, %d failed\n", command.c_str(), maps, daemons.size(), succeeded,
+              a.wait ? "updated" : "started", failed);
+  if (failed > 0) throw CLI::RuntimeError(kExitFailure);
+}
+
 }  // namespace
 
 void RegisterUpdateCommand(CLI::App& app) {
   auto a = std::make_shared<UpdateArgs>();
   CLI::App* update = app.add_subcommand("update", "Run the update job (order selection, republication) on a map now");
-  update->add_option("--map", a->map, "the map")->required();
+  CLI::Option* map = update->add_option("--map", a->map, "the map");
+  CLI::Option* all = update->add_flag(
+      "--all", a->all, "every map of every daemon of --address (A,B,C: a fleet, each daemon asked directly)");
+  map->excludes(all);
   update->add_flag("--wait", a->wait,
                    "follow the job to its end (a progress bar on a terminal, lines otherwise); exit 1 when it fails "
                    "or is cancelled");
   AddFollowOptions(update, a->follow, "with --wait");
   update->footer(
       "While an update of the map runs, a new request joins it: `fremenctl update --map M --wait` follows the "
-      "running job.\nFor a nightly cron: fremenctl update --map M --wait || alert");
-  update->callback([a] { RunUpdate(*a); });
+      "running job.\nFor a nightly cron: fremenctl update --map M --wait || alert\n"
+      "For a fleet's nightly CronJob: fremenctl update --all --wait --address all:fremend:50051 || alert");
+  update->callback([a] {
+    if (a->all) return RunUpdateAll(*a);
+    if (a->map.empty()) FailUsage("update", "name the map with --map M, or --all for every map");
+    RunUpdate(*a);
+  });
 }
 
 }  // namespace fremen::client
