@@ -7,6 +7,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "client/fremenctl/connection.h"
 #include "client/fremenctl/exit_codes.h"
 #include "client/fremenctl/print.h"
@@ -136,26 +137,39 @@ void RegisterStatusCommand(CLI::App& app) {
   auto json = std::make_shared<bool>(false);
   CLI::App* status = app.add_subcommand("status", "The daemon's version, uptime, maps, schedule, last updates and scrubs");
   status->add_flag("--json", *json, "as JSON");
-  status->footer("With several daemons (--address A,B,C): each daemon's status in turn (--json: one object per "
-                 "daemon,\n{\"daemon\": ..., \"status\": ...}); exit 1 when one does not answer.");
+  status->footer("With several daemons (--address A,B,C): each daemon's status in turn, then the fleet's sum\n"
+                 "(--json: one object per daemon, {\"daemon\": ..., \"status\": ...}); exit 1 when one does not answer.");
   status->callback([json] {
     int unreachable = 0;
-    const bool fleet = NamesAFleet();
-    for (const Daemon& daemon : ConnectEachOrExit("status")) {
-      auto s = daemon.client.GetServerStatus(GlobalCall());
-      if (!s.ok()) {
-        ReportCall("status", daemon.address, daemon.address, s.status());
+    if (!NamesAFleet()) {
+      const Client client = ConnectOrExit("status");
+      auto s = client.GetServerStatus(GlobalCall());
+      if (!s.ok()) FailCall("status", Globals().address, s.status());
+      *json ? PrintJson(*s) : PrintStatus(Globals().address, *s);
+      return;
+    }
+    const FleetStatus fleet = ConnectFleetOrExit("status").GetServerStatus(GlobalCall());
+    for (const DaemonStatus& daemon : fleet.daemons) {
+      if (!daemon.status.ok()) {
+        ReportCall("status", daemon.address, daemon.address, daemon.status);
         ++unreachable;
         continue;
       }
-      if (*json && fleet) {
-        std::printf("{\"daemon\":\"%s\",\"status\":%s}\n", daemon.address.c_str(), JsonOf(*s).c_str());
-      } else if (*json) {
-        PrintJson(*s);
+      if (*json) {
+        std::printf("{\"daemon\":\"%s\",\"status\":%s}\n", daemon.address.c_str(), JsonOf(daemon.server).c_str());
       } else {
-        if (fleet) std::printf("== %s\n", daemon.address.c_str());
-        PrintStatus(daemon.address, *s);
+        std::printf("== %s\n", daemon.address.c_str());
+        PrintStatus(daemon.address, daemon.server);
       }
+    }
+    if (!*json) {
+      const FleetStatusSummary& sum = fleet.summary;
+      std::printf("== fleet: %zu of %zu daemons answered; %llu maps, %llu states, %llu running operations, %llu failed "
+                  "maps; versions %s\n",
+                  sum.answered, sum.daemons, static_cast<unsigned long long>(sum.map_count),
+                  static_cast<unsigned long long>(sum.state_count),
+                  static_cast<unsigned long long>(sum.running_operations),
+                  static_cast<unsigned long long>(sum.failed_maps), absl::StrJoin(sum.versions, ", ").c_str());
     }
     if (unreachable > 0) throw CLI::RuntimeError(kExitFailure);
   });

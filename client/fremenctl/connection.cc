@@ -1,20 +1,13 @@
 #include "client/fremenctl/connection.h"
 
-#include <arpa/inet.h>
-#include <netdb.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-
 #include <cstdio>
 #include <fstream>
-#include <set>
 #include <sstream>
 
-#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_split.h"
 #include "client/fremenctl/exit_codes.h"
+#include "client/lib/fleet_addresses.h"
 
 namespace fremen::client {
 
@@ -51,51 +44,14 @@ void AddGlobalOptions(CLI::App& app) {
 
 CallOptions GlobalCall() { return CallOptions{.timeout = absl::Seconds(Globals().timeout_seconds)}; }
 
-std::vector<std::string> Addresses() {
-  std::vector<std::string> addresses;
-  for (absl::string_view a : absl::StrSplit(Globals().address, ',', absl::SkipWhitespace())) {
-    addresses.emplace_back(absl::StripAsciiWhitespace(a));
-  }
-  return addresses;
-}
+std::vector<std::string> Addresses() { return SplitAddressList(Globals().address); }
 
-bool NamesAFleet() {
-  const std::vector<std::string> addresses = Addresses();
-  return addresses.size() > 1 ||
-         (addresses.size() == 1 && absl::StartsWith(addresses[0], kEveryAddressPrefix));
-}
-
-absl::StatusOr<std::vector<std::string>> ResolveEvery(absl::string_view host_port) {
-  const size_t colon = host_port.rfind(':');
-  if (colon == absl::string_view::npos || colon == 0) {
-    return absl::InvalidArgumentError(absl::StrCat("all:", host_port, ": expected all:HOST:PORT"));
-  }
-  const std::string host(host_port.substr(0, colon)), port(host_port.substr(colon + 1));
-  addrinfo hints{};
-  hints.ai_family = AF_UNSPEC;
-  hints.ai_socktype = SOCK_STREAM;
-  addrinfo* found = nullptr;
-  if (const int error = getaddrinfo(host.c_str(), port.c_str(), &hints, &found); error != 0) {
-    return absl::UnavailableError(absl::StrCat("cannot resolve ", host, ": ", gai_strerror(error)));
-  }
-  std::set<std::string> addresses;
-  for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
-    char text[INET6_ADDRSTRLEN] = {};
-    if (a->ai_family == AF_INET) {
-      inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(a->ai_addr)->sin_addr, text, sizeof text);
-      addresses.insert(absl::StrCat(text, ":", port));
-    } else if (a->ai_family == AF_INET6) {
-      inet_ntop(AF_INET6, &reinterpret_cast<const sockaddr_in6*>(a->ai_addr)->sin6_addr, text, sizeof text);
-      addresses.insert(absl::StrCat("[", text, "]:", port));
-    }
-  }
-  freeaddrinfo(found);
-  return std::vector<std::string>(addresses.begin(), addresses.end());
-}
+bool NamesAFleet() { return client::NamesAFleet(Addresses()); }
 
 namespace {
 
-Client ConnectToOrExit(absl::string_view command, const std::string& address) {
+// The ConnectionOptions of the global options, for `address`.
+ConnectionOptions OptionsOrExit(absl::string_view command, const std::string& address) {
   const GlobalOptions& g = Globals();
   ConnectionOptions options;
   options.address = address;
@@ -112,7 +68,11 @@ Client ConnectToOrExit(absl::string_view command, const std::string& address) {
     options.tls = true;
     options.tls_root_certs_pem = pem.str();
   }
-  auto client = Client::Connect(std::move(options));
+  return options;
+}
+
+Client ConnectToOrExit(absl::string_view command, const std::string& address) {
+  auto client = Client::Connect(OptionsOrExit(command, address));
   if (!client.ok()) FailUsage(command, client.status().message());
   return *std::move(client);
 }
@@ -128,19 +88,11 @@ Client ConnectOrExit(absl::string_view command) {
   return ConnectToOrExit(command, addresses[0]);
 }
 
-std::vector<Daemon> ConnectEachOrExit(absl::string_view command, const std::vector<std::string>& addresses) {
-  std::vector<Daemon> daemons;
-  for (const std::string& address : addresses.empty() ? Addresses() : addresses) {
-    if (!absl::StartsWith(address, kEveryAddressPrefix)) {
-      daemons.push_back({address, ConnectToOrExit(command, address)});
-      continue;
-    }
-    auto every = ResolveEvery(address.substr(kEveryAddressPrefix.size()));
-    if (!every.ok()) FailCall(command, address, every.status());
-    for (const std::string& resolved : *every) daemons.push_back({resolved, ConnectToOrExit(command, resolved)});
-  }
-  if (daemons.empty()) FailUsage(command, "--address names no daemon");
-  return daemons;
+FleetClient ConnectFleetOrExit(absl::string_view command, const std::vector<std::string>& addresses) {
+  auto fleet = FleetClient::Connect(addresses.empty() ? Addresses() : addresses, OptionsOrExit(command, ""));
+  if (absl::IsInvalidArgument(fleet.status())) FailUsage(command, absl::StrCat("--address: ", fleet.status().message()));
+  if (!fleet.ok()) FailCall(command, Globals().address, fleet.status());
+  return *std::move(fleet);
 }
 
 std::string HintFor(const absl::Status& status, absl::string_view map, absl::string_view address) {

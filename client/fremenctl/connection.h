@@ -17,6 +17,7 @@
 #include "absl/strings/string_view.h"
 #include "absl/time/time.h"
 #include "client/lib/client.h"
+#include "client/lib/fleet_client.h"
 
 namespace fremen::client {
 
@@ -41,24 +42,16 @@ void AddGlobalOptions(CLI::App& app);
 
 // The addresses of --address, in order, as written (all:HOST:PORT not resolved).
 std::vector<std::string> Addresses();
-// Whether --address names a fleet: several addresses, or an all:HOST:PORT.
+// Whether --address names a fleet: several addresses, or an all:HOST:PORT (fleet_addresses.h).
 bool NamesAFleet();
-inline constexpr absl::string_view kEveryAddressPrefix = "all:";
-// Every address HOST resolves to, as "IP:PORT" ("[IPv6]:PORT"), sorted; `host_port` is HOST:PORT.
-absl::StatusOr<std::vector<std::string>> ResolveEvery(absl::string_view host_port);
 
 // A client for the global options. On bad options (an unreadable --tls-ca) reports and exits; so
 // does a --address naming several daemons (this command talks to one: a daemon or the proxy).
 Client ConnectOrExit(absl::string_view command);
 
-// One daemon of a fleet and a client to it.
-struct Daemon {
-  std::string address;
-  Client client;
-};
-// A client per address of --address (or of `addresses` when not empty; all:HOST:PORT resolved,
+// A FleetClient of --address's daemons (or of `addresses` when not empty; all:HOST:PORT resolved,
 // exit 1 when that fails), each with the global options' token, TLS and timeout.
-std::vector<Daemon> ConnectEachOrExit(absl::string_view command, const std::vector<std::string>& addresses = {});
+FleetClient ConnectFleetOrExit(absl::string_view command, const std::vector<std::string>& addresses = {});
 
 // The per-call options of the global --timeout.
 CallOptions GlobalCall();

@@ -17,13 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_split.h"
 #include "client/fremenctl/connection.h"
 #include "client/fremenctl/exit_codes.h"
 #include "client/fremenctl/fleet_maps.h"
+#include "client/lib/fleet_addresses.h"
 #include "client/lib/placement.h"
 
 namespace fremen::client {
@@ -36,17 +35,9 @@ struct PlacementArgs {
   std::string http;
 };
 
-std::vector<std::string> SplitList(const std::string& list) {
-  std::vector<std::string> items;
-  for (absl::string_view item : absl::StrSplit(list, ',', absl::SkipWhitespace())) {
-    items.emplace_back(absl::StripAsciiWhitespace(item));
-  }
-  return items;
-}
-
 void RunPlacement(const PlacementArgs& a) {
   const std::string command = "fleet placement";
-  const std::vector<std::string> names = a.daemons.empty() ? Addresses() : SplitList(a.daemons);
+  const std::vector<std::string> names = a.daemons.empty() ? Addresses() : SplitAddressList(a.daemons);
   for (const std::string& name : names) {
     if (absl::StartsWith(name, kEveryAddressPrefix)) {
       FailUsage(command,
@@ -55,7 +46,7 @@ void RunPlacement(const PlacementArgs& a) {
   }
   auto placement = Placement::Create(names);
   if (!placement.ok()) FailUsage(command, absl::StrCat("--daemons: ", placement.status().message()));
-  const std::vector<std::string> http = SplitList(a.http);
+  const std::vector<std::string> http = SplitAddressList(a.http);
   if (!http.empty() && http.size() != names.size()) {
     FailUsage(command, absl::StrCat("--http names ", http.size(), " addresses for ", names.size(),
                                     " daemons; give one per daemon, in the same order"));
@@ -73,17 +64,15 @@ void RunPlacement(const PlacementArgs& a) {
     return;
   }
 
-  const FleetMaps fleet = ListEachDaemon(command, ConnectEachOrExit(command, names));
+  const FleetMaps fleet = ListFleetOrReport(command, ConnectFleetOrExit(command, names));
   int misplaced = 0;
   std::printf("MAP OWNER%s HELD-BY\n", http_header.c_str());
-  for (const DaemonMaps& daemon : fleet.daemons) {
-    for (const v1::Map& map : daemon.maps) {
-      const std::string& owner = placement->Owner(map.name());
-      const bool placed = owner == daemon.address;
-      if (!placed) ++misplaced;
-      std::printf("%s %s%s %s%s\n", map.name().c_str(), owner.c_str(), http_of(map.name()).c_str(),
-                  daemon.address.c_str(), placed ? "" : " MISPLACED");
-    }
+  for (const FleetMap& held : fleet.maps) {
+    const std::string& owner = placement->Owner(held.map.name());
+    const bool placed = owner == held.daemon;
+    if (!placed) ++misplaced;
+    std::printf("%s %s%s %s%s\n", held.map.name().c_str(), owner.c_str(), http_of(held.map.name()).c_str(),
+                held.daemon.c_str(), placed ? "" : " MISPLACED");
   }
   if (misplaced > 0) {
     std::fprintf(stderr,
@@ -91,7 +80,7 @@ void RunPlacement(const PlacementArgs& a) {
                  "to the owner, which does not have them\n",
                  command.c_str(), misplaced);
   }
-  if (misplaced > 0 || fleet.unreachable > 0) throw CLI::RuntimeError(kExitFailure);
+  if (misplaced > 0 || !fleet.Unreachable().empty()) throw CLI::RuntimeError(kExitFailure);
 }
 
 }  // namespace

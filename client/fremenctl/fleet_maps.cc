@@ -1,21 +1,16 @@
 #include "client/fremenctl/fleet_maps.h"
 
 #include "absl/strings/str_cat.h"
+#include "client/fremenctl/connection.h"
 
 namespace fremen::client {
 
-FleetMaps ListEachDaemon(absl::string_view command, const std::vector<Daemon>& daemons) {
-  FleetMaps fleet;
-  for (const Daemon& daemon : daemons) {
-    auto maps = daemon.client.ListAllMaps(GlobalCall());
-    if (!maps.ok()) {
-      ReportCall(command, daemon.address, absl::StrCat("listing the maps of ", daemon.address), maps.status());
-      ++fleet.unreachable;
-      continue;
-    }
-    fleet.daemons.push_back({daemon.address, *std::move(maps)});
+FleetMaps ListFleetOrReport(absl::string_view command, const FleetClient& fleet) {
+  FleetMaps maps = fleet.ListAllMaps(GlobalCall());
+  for (const DaemonAnswer& daemon : maps.Unreachable()) {
+    ReportCall(command, daemon.address, absl::StrCat("listing the maps of ", daemon.address), daemon.status);
   }
-  return fleet;
+  return maps;
 }
 
 }  // namespace fremen::client

@@ -8,7 +8,6 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -158,26 +157,25 @@ void RegisterCreate(CLI::App& maps) {
   });
 }
 
-// `maps list --address A,B,C`: every daemon's maps, merged in name order.
+// `maps list --address A,B,C`: every daemon's maps, merged in name order; a map that several
+// daemons hold is on one line per daemon, marked DUPLICATE.
 void ListFleet(bool json) {
-  const FleetMaps fleet = ListEachDaemon("maps list", ConnectEachOrExit("maps list"));
-  std::vector<std::pair<const v1::Map*, const std::string*>> rows;
-  for (const DaemonMaps& daemon : fleet.daemons) {
-    for (const v1::Map& map : daemon.maps) rows.emplace_back(&map, &daemon.address);
-  }
-  std::sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) {
-    return std::tie(a.first->name(), *a.second) < std::tie(b.first->name(), *b.second);
-  });
+  const FleetMaps fleet = ListFleetOrReport("maps list", ConnectFleetOrExit("maps list"));
   if (!json) std::printf("%-32s %-28s %-40s %s\n", "NAME", "DAEMON", "SHAPE", "CREATED");
-  for (const auto& [map, daemon] : rows) {
+  for (const FleetMap& held : fleet.maps) {
     if (json) {
-      std::printf("{\"daemon\":\"%s\",\"map\":%s}\n", daemon->c_str(), JsonOf(*map).c_str());
+      std::printf("{\"daemon\":\"%s\",\"duplicate\":%s,\"map\":%s}\n", held.daemon.c_str(),
+                  held.duplicate ? "true" : "false", JsonOf(held.map).c_str());
     } else {
-      std::printf("%-32s %-28s %-40s %s\n", map->name().c_str(), daemon->c_str(), Shape(*map).c_str(),
-                  FormatTimestamp(map->create_time()).c_str());
+      std::printf("%-32s %-28s %-40s %s%s\n", held.map.name().c_str(), held.daemon.c_str(), Shape(held.map).c_str(),
+                  FormatTimestamp(held.map.create_time()).c_str(), held.duplicate ? " DUPLICATE" : "");
     }
   }
-  if (fleet.unreachable > 0) throw CLI::RuntimeError(kExitFailure);
+  if (!fleet.duplicates.empty()) {
+    std::fprintf(stderr, "fremenctl maps list: %zu maps are held by more than one daemon (a move in progress?)\n",
+                 fleet.duplicates.size());
+  }
+  if (!fleet.Unreachable().empty()) throw CLI::RuntimeError(kExitFailure);
 }
 
 void RegisterList(CLI::App& maps) {

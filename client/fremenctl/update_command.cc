@@ -41,33 +41,31 @@ void RunUpdate(const UpdateArgs& a) {
 // any failed, or a daemon did not answer.
 void RunUpdateAll(const UpdateArgs& a) {
   const std::string command = "update --all";
-  const std::vector<Daemon> daemons = ConnectEachOrExit(command);
-  const FleetMaps fleet = ListEachDaemon(command, daemons);
+  const FleetClient daemons = ConnectFleetOrExit(command);
+  const FleetMaps fleet = ListFleetOrReport(command, daemons);
   struct Started {
-    const Daemon* daemon;
+    const FleetMember* daemon;
     v1::Operation op;
   };
   std::vector<Started> started;
-  int failed = fleet.unreachable;
-  size_t maps = 0;
-  for (const DaemonMaps& held : fleet.daemons) {
-    const Daemon* daemon = nullptr;
-    for (const Daemon& d : daemons) {
-      if (d.address == held.address) daemon = &d;
+  int failed = static_cast<int>(fleet.Unreachable().size());
+  for (const FleetMap& held : fleet.maps) {
+    const FleetMember* daemon = nullptr;
+    for (const FleetMember& d : daemons.members()) {
+      if (d.address == held.daemon) daemon = &d;
     }
-    for (const v1::Map& map : held.maps) {
-      ++maps;
-      auto op = daemon->client.RunUpdate(map.name(), GlobalCall());
-      if (!op.ok()) {
-        ReportCall(command, held.address, absl::StrCat("map ", map.name(), " on ", held.address), op.status(),
-                   map.name());
-        ++failed;
-        continue;
-      }
-      std::printf("started %s (update of %s on %s)\n", op->name().c_str(), map.name().c_str(), held.address.c_str());
-      started.push_back({daemon, *std::move(op)});
+    auto op = daemon->client.RunUpdate(held.map.name(), GlobalCall());
+    if (!op.ok()) {
+      ReportCall(command, held.daemon, absl::StrCat("map ", held.map.name(), " on ", held.daemon), op.status(),
+                 held.map.name());
+      ++failed;
+      continue;
     }
+    std::printf("started %s (update of %s on %s)\n", op->name().c_str(), held.map.name().c_str(),
+                held.daemon.c_str());
+    started.push_back({daemon, *std::move(op)});
   }
+  const size_t maps = fleet.maps.size();
   std::fflush(stdout);
   size_t succeeded = started.size();
   if (a.wait) {
@@ -86,7 +84,7 @@ void RunUpdateAll(const UpdateArgs& a) {
       std::fflush(stdout);
     }
   }
-  std::printf("%s: %zu maps on %zu daemons: %zu %s, %d failed\n", command.c_str(), maps, daemons.size(), succeeded,
+  std::printf("%s: %zu maps on %zu daemons: %zu %s, %d failed\n", command.c_str(), maps, daemons.members().size(), succeeded,
               a.wait ? "updated" : "started", failed);
   if (failed > 0) throw CLI::RuntimeError(kExitFailure);
 }

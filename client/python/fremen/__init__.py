@@ -21,18 +21,21 @@ from fremen.client import (DEFAULT_ADDRESS, AnomalyCheck, Client, NamedState, Pr
                            connect)
 from fremen.errors import (AlreadyExists, DeadlineExceeded, Error, FailedPrecondition, InvalidArgument, NotFound,
                            OutOfRange, PermissionDenied, ResourceExhausted, Unauthenticated, Unavailable)
+from fremen.fleet import DaemonError, DaemonStatus, FleetClient, FleetMap, FleetMaps, FleetStatus, FleetSummary
 from fremen.ingest import Ack, Batch, IngestSession, Rejection
 from fremen.maps import MapInfo, MapStats, MapUpdate
 from fremen.model import Component, OrderError, Persistence, StateModel
 from fremen.operations import Operation, Progress, UpdateResult
+from fremen.placement import Placement
 from fremen.retry import Backoff
 from fremen.status import Backup, CheckProblem, MapScrub, ServerStatus
 
 __all__ = [
     "DEFAULT_ADDRESS", "Ack", "AlreadyExists", "AnomalyCheck", "Array", "Backoff", "Backup", "Batch",
-    "CheckProblem", "Client", "Component", "DeadlineExceeded", "Error", "FailedPrecondition", "FlatArray",
+    "CheckProblem", "Client", "Component", "DaemonError", "DaemonStatus", "DeadlineExceeded", "Error",
+    "FailedPrecondition", "FlatArray", "FleetClient", "FleetMap", "FleetMaps", "FleetStatus", "FleetSummary",
     "IngestSession", "InvalidArgument", "MapInfo", "MapScrub", "MapStats", "MapUpdate", "NamedState", "NotFound",
-    "Operation", "OrderError", "OutOfRange", "PermissionDenied", "Persistence", "Prediction", "Progress",
+    "Operation", "OrderError", "OutOfRange", "PermissionDenied", "Persistence", "Placement", "Prediction", "Progress",
     "Reconstruction", "Rejection", "ResourceExhausted", "ScoredState", "ServerStatus", "StateModel",
     "Unauthenticated", "Unavailable", "UpdateResult", "__version__", "connect",
 ]
