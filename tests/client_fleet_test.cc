@@ -3,6 +3,7 @@
 // that holds it, a map on two daemons is reported on both, each daemon's status and their sum;
 // after kill -9 of one daemon its address and UNAVAILABLE come back beside the others' answers.
 // Every daemon wants tokens, and the fleet's one ConnectionOptions carries the token to each.
+// fremenctl's --address A,B,C views, built on the same FleetClient, run as a subprocess.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -12,6 +13,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "client/lib/client.h"
 #include "client/lib/fleet_client.h"
 #include "client/lib/placement.h"
@@ -204,6 +206,31 @@ TEST_F(FleetClientTest, AllHostPortIsEveryAddressTheNameResolvesTo) {
   auto twice = FleetClient::Connect({addresses_[0], addresses_[0]}, Options());
   EXPECT_EQ(twice.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(twice.status().message(), HasSubstr("named twice"));
+}
+
+// fremenctl's fleet views are the library's: the same merge, duplicates marked, the daemon that
+// does not answer reported and the command exiting 1 after listing the others.
+TEST_F(FleetClientTest, FremenctlListsTheFleetThroughTheLibrary) {
+  CreateOn(0, "office");
+  CreateOn(2, "office");
+  CreateOn(2, "atrium");
+  daemons_[1]->Kill();
+  const std::string fleet = absl::StrCat(addresses_[0], ",", addresses_[1], ",", addresses_[2]);
+  const RunResult list =
+      RunProgram(FREMENCTL_BINARY, {"maps", "list", "--address", fleet, "--token", kWriteToken, "--timeout", "10"});
+  EXPECT_EQ(list.exit_code, 1) << list.out << list.err;
+  std::vector<std::string> lines = absl::StrSplit(list.out, '\n', absl::SkipEmpty());
+  ASSERT_EQ(lines.size(), 4u) << list.out;
+  EXPECT_THAT(lines[1], ::testing::StartsWith("atrium"));
+  EXPECT_THAT(lines[2], ::testing::AllOf(HasSubstr(addresses_[0]), HasSubstr("DUPLICATE")));
+  EXPECT_THAT(lines[3], ::testing::AllOf(HasSubstr(addresses_[2]), HasSubstr("DUPLICATE")));
+  EXPECT_THAT(list.err, HasSubstr(absl::StrCat("listing the maps of ", addresses_[1])));
+  EXPECT_THAT(list.err, HasSubstr("1 maps are held by more than one daemon"));
+
+  const RunResult status =
+      RunProgram(FREMENCTL_BINARY, {"status", "--address", fleet, "--token", kWriteToken, "--timeout", "10"});
+  EXPECT_EQ(status.exit_code, 1) << status.out << status.err;
+  EXPECT_THAT(status.out, HasSubstr("== fleet: 2 of 3 daemons answered; 3 maps"));
 }
 
 }  // namespace
