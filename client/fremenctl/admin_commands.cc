@@ -137,8 +137,9 @@ void RegisterStatusCommand(CLI::App& app) {
   auto json = std::make_shared<bool>(false);
   CLI::App* status = app.add_subcommand("status", "The daemon's version, uptime, maps, schedule, last updates and scrubs");
   status->add_flag("--json", *json, "as JSON");
-  status->footer("With several daemons (--address A,B,C): each daemon's status in turn, then the fleet's sum\n"
-                 "(--json: one object per daemon, {\"daemon\": ..., \"status\": ...}); exit 1 when one does not answer.");
+  status->footer(
+      "With several daemons (--address A,B,C): each daemon's status in turn, then the fleet's sum\n"
+      "(--json: one object per daemon, {\"daemon\": ..., \"status\": ...}); exit 1 when one does not answer.");
   status->callback([json] {
     int unreachable = 0;
     if (!NamesAFleet()) {

@@ -90,7 +90,9 @@ Client ConnectOrExit(absl::string_view command) {
 
 FleetClient ConnectFleetOrExit(absl::string_view command, const std::vector<std::string>& addresses) {
   auto fleet = FleetClient::Connect(addresses.empty() ? Addresses() : addresses, OptionsOrExit(command, ""));
-  if (absl::IsInvalidArgument(fleet.status())) FailUsage(command, absl::StrCat("--address: ", fleet.status().message()));
+  if (absl::IsInvalidArgument(fleet.status())) {
+    FailUsage(command, absl::StrCat("--address: ", fleet.status().message()));
+  }
   if (!fleet.ok()) FailCall(command, Globals().address, fleet.status());
   return *std::move(fleet);
 }

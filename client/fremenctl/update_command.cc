@@ -84,8 +84,8 @@ void RunUpdateAll(const UpdateArgs& a) {
       std::fflush(stdout);
     }
   }
-  std::printf("%s: %zu maps on %zu daemons: %zu %s, %d failed\n", command.c_str(), maps, daemons.members().size(), succeeded,
-              a.wait ? "updated" : "started", failed);
+  std::printf("%s: %zu maps on %zu daemons: %zu %s, %d failed\n", command.c_str(), maps, daemons.members().size(),
+              succeeded, a.wait ? "updated" : "started", failed);
   if (failed > 0) throw CLI::RuntimeError(kExitFailure);
 }
 

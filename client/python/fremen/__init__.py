@@ -7,6 +7,9 @@
             session.send(1.7e9, [1, 0], names=["front", "back"])
         print(client.predict("doors", [1.7e9 + 3600], names=["front", "back"]).probabilities)
 
+fremen.FleetClient(["a:50051", "b:50051"] or "all:fremend:50051") asks every daemon of a fleet for
+its maps and status and merges the answers (fremen.fleet).
+
 Every call answers the package's own frozen dataclasses (MapInfo, Prediction, Operation, ...), each
 result of a single message keeping it as `proto`. The package is the hand-written modules beside
 this file plus the generated messages and stubs in the subpackage fremen.v1 (protoc's output for
