@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 
+#include "storage/model/kernels/cpu_dispatch.h"
+
 namespace fremen::model {
 namespace {
 
@@ -102,18 +104,20 @@ void Predict(const CompactModels& models, Records records, size_t count, const P
 
 }  // namespace
 
-void PredictRegion(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order,
-                   float* out) {
+// Cloned for AVX2 (cpu_dispatch.h): its gathers of cos_t[k[j]] and 8-wide lanes are most of what a
+// native build gains here.
+FREMEN_KERNEL_CLONES void PredictRegion(const CompactModels& models, size_t first, size_t count,
+                                        const PhasorTable& phasors, int order, float* out) {
   Predict(models, Consecutive{first}, count, phasors, order, out);
 }
 
-void PredictRegionU8(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order,
-                     uint8_t* out) {
+FREMEN_KERNEL_CLONES void PredictRegionU8(const CompactModels& models, size_t first, size_t count,
+                                          const PhasorTable& phasors, int order, uint8_t* out) {
   Predict(models, Consecutive{first}, count, phasors, order, out);
 }
 
-void PredictRecords(const CompactModels& models, std::span<const uint32_t> records, const PhasorTable& phasors,
-                    int order, float* out) {
+FREMEN_KERNEL_CLONES void PredictRecords(const CompactModels& models, std::span<const uint32_t> records,
+                                         const PhasorTable& phasors, int order, float* out) {
   Predict(models, Listed{records.data()}, records.size(), phasors, order, out);
 }
 
