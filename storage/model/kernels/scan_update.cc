@@ -80,7 +80,7 @@ absl::Status ValidateScan(size_t cell_count, std::span<const uint32_t> cells, st
   return absl::OkStatus();
 }
 
-// The two update kernels are cloned for AVX2 (cpu_dispatch.h); the fold is 4K independent lanes.
+// The two update kernels are cloned for AVX2 (cpu_dispatch.h): the fold is 4K independent lanes.
 FREMEN_KERNEL_CLONES void ApplyScan(RecordArena& arena, const ScanPhasors<float>& phasors,
                                     std::span<const uint32_t> cells, std::span<const float> values) {
   WithPeriodCount(phasors.periods(), [&]<size_t kPeriods>() {
