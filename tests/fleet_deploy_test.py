@@ -239,7 +239,21 @@ class DockerfileTest(unittest.TestCase):
         self.assertNotIn(users[-1].split(":")[0], ("root", "0"))
         self.assertTrue(any(line.startswith("HEALTHCHECK ") for line in lines))
         self.assertTrue(any(line.startswith("ENTRYPOINT") and "fremend" in line for line in lines))
-        self.assertTrue(any("FREMEN_NATIVE" in line for line in lines))
+        # Portable: the image's build takes the repository's portable default, never -march=native.
+        self.assertTrue(any(line.startswith("ARG FREMEN_MARCH=") and "native" not in line for line in lines))
+
+    def test_the_build_stage_installs_every_library_the_build_needs(self):
+        # Every -dev package (and the embedded Chart.js) that scripts/install-deps.sh installs for the
+        # build: CMake's configure needs them all, and one missing breaks only the image's build.
+        with open(os.path.join(ROOT, "scripts", "install-deps.sh")) as f:
+            listed = re.search(r"^packages=\((.*?)^\)", f.read(), re.S | re.M).group(1)
+        words = [w for line in listed.splitlines() for w in line.split("#")[0].split()]
+        needed = [w for w in words if w.endswith("-dev") or w == "libjs-chart.js"]
+        self.assertIn("libpng-dev", needed)
+        with open(os.path.join(ROOT, "deploy", "Dockerfile")) as f:
+            build_stage = f.read().split("FROM ")[1]
+        installed = set(re.findall(r"[a-z0-9][a-z0-9.+-]+", build_stage))
+        self.assertEqual([p for p in needed if p not in installed], [])
 
 
 def kubectl_dry_run():

@@ -3,6 +3,7 @@
 #include <cassert>
 
 #include "absl/strings/str_cat.h"
+#include "storage/model/kernels/cpu_dispatch.h"
 #include "storage/model/model_settings.h"
 
 namespace fremen::model {
@@ -79,8 +80,9 @@ absl::Status ValidateScan(size_t cell_count, std::span<const uint32_t> cells, st
   return absl::OkStatus();
 }
 
-void ApplyScan(RecordArena& arena, const ScanPhasors<float>& phasors, std::span<const uint32_t> cells,
-               std::span<const float> values) {
+// The two update kernels are cloned for AVX2 (cpu_dispatch.h): the fold is 4K independent lanes.
+FREMEN_KERNEL_CLONES void ApplyScan(RecordArena& arena, const ScanPhasors<float>& phasors,
+                                    std::span<const uint32_t> cells, std::span<const float> values) {
   WithPeriodCount(phasors.periods(), [&]<size_t kPeriods>() {
     ForEachCell(
         cells, values,
@@ -89,8 +91,8 @@ void ApplyScan(RecordArena& arena, const ScanPhasors<float>& phasors, std::span<
   });
 }
 
-void ApplyDenseScan(RecordArena& arena, const ScanPhasors<float>& phasors, size_t first,
-                    std::span<const float> values) {
+FREMEN_KERNEL_CLONES void ApplyDenseScan(RecordArena& arena, const ScanPhasors<float>& phasors, size_t first,
+                                         std::span<const float> values) {
   assert(first + values.size() <= arena.size());
   // The hardware prefetcher alone leaves the loop alternating between computing and waiting; an
   // explicit hint a few records ahead overlaps the two (measured 36M -> 48-52M records/s at K = 24).

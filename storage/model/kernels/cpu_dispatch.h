@@ -1,0 +1,39 @@
+// Run-time dispatch of the hot kernels' entry points (README, "Portable binaries").
+//
+// The default build is portable (-march=x86-64-v2: SSE4.2, 128-bit vectors), which cost the scan
+// update kernels 8-30 % against -march=native (docs/performance.md, "Portable binaries").
+// FREMEN_KERNEL_CLONES on a function definition makes GCC compile it twice, for AVX2 and for the
+// build's own target, and pick one when the binary is loaded (an ifunc resolver: no cost per call).
+// The whole kernel must be inside the cloned function to profit: [[gnu::flatten]] inlines the
+// helpers it calls (FoldObservation, the prefetches) into each clone. Used on ApplyScan and
+// ApplyDenseScan only: region prediction is scalar per cell (its loop over a state's few components
+// is a dependent sum) and measured no better as an AVX2 clone.
+//
+// The clone is "avx2", deliberately not "arch=x86-64-v3": that one includes FMA, and with FMA the
+// compiler fuses a·b + c into one rounding (C++'s default -ffp-contract=fast), so the AVX2 path would
+// round differently from the default path and from the same inline code elsewhere (FoldObservation
+// in BasicSpectrum): a map's records would then depend on which node ingested or replayed its log.
+// Without FMA both paths do the same IEEE operations per element, in the same order, and give
+// bit-identical records (cpu_dispatch_test.cc); only the vector width differs.
+//
+// Empty where it would add nothing or is not supported: a build whose target already has AVX2
+// (FREMEN_MARCH=native on such a machine), other architectures, compilers other than GCC, and
+// sanitizer builds.
+#pragma once
+
+#if defined(__x86_64__) && !defined(__AVX2__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+#define FREMEN_KERNEL_CLONES [[gnu::target_clones("avx2", "default"), gnu::flatten]]
+#define FREMEN_KERNEL_CLONES_ENABLED 1
+#else
+#define FREMEN_KERNEL_CLONES
+#define FREMEN_KERNEL_CLONES_ENABLED 0
+#endif
+
+namespace fremen::model {
+
+// Which clone the loader chose in this process: "avx2", "default" (the build's own target), or
+// "none" (no clones in this build). For logs and tests.
+const char* KernelDispatchPath();
+
+}  // namespace fremen::model
