@@ -1,7 +1,8 @@
 #include "server/http/http_status.h"
 
-#include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
+
+#include "fremen/v1/rpc_status.pb.h"
 
 namespace fremen::server {
 
@@ -38,15 +39,15 @@ int HttpStatusOf(absl::StatusCode code) {
 }
 
 std::string StatusBody(const absl::Status& status) {
-  // google.rpc.Status is not among Debian's protobuf headers: the same shape as a Struct, printed
-  // by protobuf's JSON mapping (no hand-written JSON escaping).
-  google::protobuf::Struct body;
-  auto& fields = *body.mutable_fields();
-  fields["code"].set_number_value(static_cast<int>(status.code()));
-  fields["message"].set_string_value(std::string(status.message()));
-  fields["details"].mutable_list_value();
+  // google.rpc.Status's shape (proto/fremen/v1/rpc_status.proto), printed by protobuf's JSON
+  // mapping: no hand-written JSON escaping.
+  v1::RpcStatus body;
+  body.set_code(static_cast<int>(status.code()));
+  body.set_message(std::string(status.message()));
+  google::protobuf::util::JsonPrintOptions options;
+  options.always_print_primitive_fields = true;  // "details": [] too, as google.rpc.Status has it
   std::string json;
-  (void)google::protobuf::util::MessageToJsonString(body, &json);
+  (void)google::protobuf::util::MessageToJsonString(body, &json, options);
   return json + "\n";
 }
 

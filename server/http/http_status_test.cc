@@ -1,7 +1,8 @@
 #include "server/http/http_status.h"
 
-#include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
+
+#include "fremen/v1/rpc_status.pb.h"
 
 #include "gtest/gtest.h"
 
@@ -22,11 +23,12 @@ TEST(HttpStatusTest, GrpcCodesMapAsGrpcGatewayMapsThem) {
 
 TEST(HttpStatusTest, TheBodyIsAGoogleRpcStatus) {
   const std::string body = StatusBody(absl::NotFoundError("no map \"x\" (\\ and \" escaped)"));
-  google::protobuf::Struct parsed;
+  v1::RpcStatus parsed;
   ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(body, &parsed).ok()) << body;
-  EXPECT_EQ(parsed.fields().at("code").number_value(), 5);
-  EXPECT_EQ(parsed.fields().at("message").string_value(), "no map \"x\" (\\ and \" escaped)");
-  EXPECT_EQ(parsed.fields().at("details").list_value().values_size(), 0);
+  EXPECT_EQ(parsed.code(), 5);
+  EXPECT_EQ(parsed.message(), "no map \"x\" (\\ and \" escaped)");
+  EXPECT_EQ(parsed.details_size(), 0);
+  EXPECT_NE(body.find("\"details\":[]"), std::string::npos) << body;
   EXPECT_NE(body.find("\"code\":5"), std::string::npos) << body;  // an integer, as google.rpc.Status has it
 }
 
