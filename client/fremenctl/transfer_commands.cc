@@ -24,13 +24,13 @@ constexpr char kMagic[] = "fremen map export 1\n";
 // Copies of whole maps: the global --timeout (meant for queries) is raised to at least this.
 constexpr double kMinTransferSeconds = 3600;
 
+}  // namespace
+
 CallOptions TransferCall() {
   CallOptions call = GlobalCall();
   call.timeout = std::max(*call.timeout, absl::Seconds(kMinTransferSeconds));
   return call;
 }
-
-}  // namespace
 
 void RegisterExportCommand(CLI::App& app) {
   struct Args {

@@ -5,10 +5,14 @@
 #pragma once
 
 #include "CLI/CLI.hpp"
+#include "client/lib/options.h"
 
 namespace fremen::client {
 
 void RegisterExportCommand(CLI::App& app);
 void RegisterImportCommand(CLI::App& app);
+
+// The global options' call, with a deadline long enough to copy a whole map (at least an hour).
+CallOptions TransferCall();
 
 }  // namespace fremen::client

@@ -462,17 +462,7 @@ absl::Status AdminServiceImpl::Move(const v1::SetMapMoveRequest& request, const 
   }
   if (!status.ok()) return status;
   const storage::MoveStatus move = (*map)->Move();
-  switch (move.state) {
-    case storage::MoveState::kServing:
-      response.set_state(v1::MAP_MOVE_STATE_SERVING);
-      break;
-    case storage::MoveState::kWritesStopped:
-      response.set_state(v1::MAP_MOVE_STATE_WRITES_STOPPED);
-      break;
-    case storage::MoveState::kMoved:
-      response.set_state(v1::MAP_MOVE_STATE_MOVED);
-      break;
-  }
+  response.set_state(MoveStateToProto(move.state));
   response.set_moved_to(move.moved_to);
   return absl::OkStatus();
 }
