@@ -807,6 +807,13 @@ absl::StatusOr<uint64_t> MapStoreImpl::Backup(const std::string& dir) {
     if (absl::Status s = shards_[i]->env().CopyTo(ShardDir(dir, i)); !s.ok()) return s;
   }
   if (absl::Status s = WriteFileAtomically(options_.env, dir + "/map.info", EncodeMapInfo(info_)); !s.ok()) return s;
+  {
+    // The last update job's record comes along, so that a restored (or moved) map reports it.
+    base::MutexLock lock(&last_update_mutex_);
+    if (last_update_) {
+      if (absl::Status s = WriteUpdateRecord(options_.env, LastUpdatePath(dir), *last_update_); !s.ok()) return s;
+    }
+  }
   uint64_t bytes = 0;
   std::error_code error;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(dir, error)) {

@@ -19,6 +19,15 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr char kMapInfoFile[] = "map.info";
+constexpr char kLastUpdateFile[] = "last_update";
+
+absl::Status WriteWhole(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out << bytes;
+  out.close();
+  if (!out) return absl::InternalError(absl::StrCat("cannot write ", path));
+  return absl::OkStatus();
+}
 
 std::string ShardFile(uint32_t shard) { return absl::StrCat("shard-", shard, "/data.mdb"); }
 
@@ -108,6 +117,11 @@ absl::Status ExportMap(storage::Store& store, const std::string& name, const std
   auto encoded = ReadWhole(absl::StrCat(dir, "/", kMapInfoFile));
   if (!encoded.ok()) return encoded.status();
   header.set_map_info(*std::move(encoded));
+  if (fs::exists(absl::StrCat(dir, "/", kLastUpdateFile))) {
+    auto last = ReadWhole(absl::StrCat(dir, "/", kLastUpdateFile));
+    if (!last.ok()) return last.status();
+    header.set_last_update(*std::move(last));
+  }
   std::vector<char> buffer(chunk_bytes);
   for (uint32_t i = 0; i < info->shards; ++i) {
     const std::string path = absl::StrCat(dir, "/", ShardFile(i));
@@ -199,10 +213,10 @@ absl::Status MapImportWriter::AddHeader(const v1::MapExportHeader& header) {
                                                      header.files(i).path(), "\""));
     }
   }
-  std::ofstream out(absl::StrCat(dir_, "/", kMapInfoFile), std::ios::binary);
-  out << header.map_info();
-  out.close();
-  if (!out) return absl::InternalError(absl::StrCat("cannot write ", dir_, "/", kMapInfoFile));
+  if (absl::Status s = WriteWhole(absl::StrCat(dir_, "/", kMapInfoFile), header.map_info()); !s.ok()) return s;
+  if (!header.last_update().empty()) {
+    if (absl::Status s = WriteWhole(absl::StrCat(dir_, "/", kLastUpdateFile), header.last_update()); !s.ok()) return s;
+  }
   header_ = header;
   return absl::OkStatus();
 }

@@ -206,7 +206,8 @@ class MapStore {
                                                                        size_t n,
                                                                        const PredictOptions& options) const = 0;
   virtual MapStats Stats() const = 0;
-  // A consistent copy of every shard and the map's info into `dir` (created, must be empty).
+  // A consistent copy of every shard, the map's info and its last update record into `dir`
+  // (created, must be empty).
   // Returns the bytes written.
   virtual absl::StatusOr<uint64_t> Backup(const std::string& dir) = 0;
   // Verifies the map's files while it serves (storage/verify.h). Each shard is read in a forked
