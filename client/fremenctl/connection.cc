@@ -5,6 +5,7 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <set>
@@ -50,6 +51,10 @@ void AddGlobalOptions(CLI::App& app) {
 }
 
 CallOptions GlobalCall() { return CallOptions{.timeout = absl::Seconds(Globals().timeout_seconds)}; }
+
+CallOptions GlobalCallOfAtLeast(absl::Duration minimum) {
+  return CallOptions{.timeout = std::max(absl::Seconds(Globals().timeout_seconds), minimum)};
+}
 
 std::vector<std::string> Addresses() {
   std::vector<std::string> addresses;

@@ -26,11 +26,7 @@ constexpr double kMinTransferSeconds = 3600;
 
 }  // namespace
 
-CallOptions TransferCall() {
-  CallOptions call = GlobalCall();
-  call.timeout = std::max(*call.timeout, absl::Seconds(kMinTransferSeconds));
-  return call;
-}
+CallOptions TransferCall() { return GlobalCallOfAtLeast(absl::Seconds(kMinTransferSeconds)); }
 
 void RegisterExportCommand(CLI::App& app) {
   struct Args {

@@ -89,20 +89,14 @@ void StartBlockingStream(const ServiceDeps& deps, grpc::CallbackServerContext* c
   }
 }
 
-template <typename Response>
-class BlockingWriteReactor final : public grpc::ServerWriteReactor<Response>, public StreamWriter<Response> {
+// What both kinds of reactor share: the access log's record, the tracker, the one Finish.
+template <typename Reactor>
+class BlockingReactor : public Reactor {
  public:
-  BlockingWriteReactor(grpc::CallbackServerContext* context, const MethodSpec& method, const ServiceDeps& deps)
+  BlockingReactor(grpc::CallbackServerContext* context, const MethodSpec& method, const ServiceDeps& deps)
       : record_(method.name, *context, deps.observer), calls_(deps.calls) {}
 
-  bool Write(const Response& message) override {
-    written_.Start();
-    this->StartWrite(&message);
-    return written_.Wait();
-  }
-  void OnWriteDone(bool ok) override { written_.Done(ok); }
   void OnDone() override { delete this; }
-
   void End(const absl::Status& status, bool counted) {
     const grpc::Status converted = ToGrpcStatus(status);
     record_.Finish(converted);
@@ -114,14 +108,30 @@ class BlockingWriteReactor final : public grpc::ServerWriteReactor<Response>, pu
  private:
   CallRecord record_;
   CallTracker* const calls_;
+};
+
+template <typename Response>
+class BlockingWriteReactor final : public BlockingReactor<grpc::ServerWriteReactor<Response>>,
+                                   public StreamWriter<Response> {
+ public:
+  using BlockingReactor<grpc::ServerWriteReactor<Response>>::BlockingReactor;
+
+  bool Write(const Response& message) override {
+    written_.Start();
+    this->StartWrite(&message);
+    return written_.Wait();
+  }
+  void OnWriteDone(bool ok) override { written_.Done(ok); }
+
+ private:
   StreamCompletion written_;
 };
 
 template <typename Request>
-class BlockingReadReactor final : public grpc::ServerReadReactor<Request>, public StreamReader<Request> {
+class BlockingReadReactor final : public BlockingReactor<grpc::ServerReadReactor<Request>>,
+                                  public StreamReader<Request> {
  public:
-  BlockingReadReactor(grpc::CallbackServerContext* context, const MethodSpec& method, const ServiceDeps& deps)
-      : record_(method.name, *context, deps.observer), calls_(deps.calls) {}
+  using BlockingReactor<grpc::ServerReadReactor<Request>>::BlockingReactor;
 
   bool Read(Request& message) override {
     if (ended_) return false;
@@ -131,19 +141,8 @@ class BlockingReadReactor final : public grpc::ServerReadReactor<Request>, publi
     return !ended_;
   }
   void OnReadDone(bool ok) override { read_.Done(ok); }
-  void OnDone() override { delete this; }
-
-  void End(const absl::Status& status, bool counted) {
-    const grpc::Status converted = ToGrpcStatus(status);
-    record_.Finish(converted);
-    CallTracker* const calls = calls_;
-    this->Finish(converted);
-    if (counted) calls->End();
-  }
 
  private:
-  CallRecord record_;
-  CallTracker* const calls_;
   StreamCompletion read_;
   bool ended_ = false;  // the body's thread only
 };

@@ -41,6 +41,7 @@ grpc::ServerUnaryReactor* MapServiceImpl::CreateMap(grpc::CallbackServerContext*
     auto created = (*store)->CreateMap(*std::move(info));
     if (!created.ok()) return RenameStorageFields(created.status());
     MapInfoToProto(*created, *response->mutable_map());
+    AddMoveState(**store, *response->mutable_map());
     return absl::OkStatus();
   });
 }
