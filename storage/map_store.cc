@@ -29,6 +29,7 @@ constexpr char kQueueFullPayload[] = "type.fremen/storage.QueueFull";
 
 std::string ShardDir(const std::string& dir, uint32_t i) { return absl::StrCat(dir, "/shard-", i); }
 std::string LastUpdatePath(const std::string& dir) { return dir + "/last_update"; }
+std::string MovedToPath(const std::string& dir) { return dir + "/moved_to"; }
 
 absl::Status MakeDir(const std::string& dir) {
   if (mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) {
@@ -38,6 +39,10 @@ absl::Status MakeDir(const std::string& dir) {
 }
 
 }  // namespace
+
+absl::Status MovingError(const std::string& map) {
+  return absl::UnavailableError(absl::StrCat("map ", map, " is moving to another daemon; retry"));
+}
 
 bool IsQueueFull(const absl::Status& status) {
   return status.code() == absl::StatusCode::kResourceExhausted && status.GetPayload(kQueueFullPayload).has_value();
@@ -110,6 +115,13 @@ absl::StatusOr<std::unique_ptr<MapStoreImpl>> MapStoreImpl::Open(const MapInfo& 
   store->observer_->Recovered(absl::Now() - recovery_start);
   // Only a report: an unreadable record is shown as none rather than keeping the map closed.
   if (auto last = ReadUpdateRecord(options.env, LastUpdatePath(dir)); last.ok()) store->last_update_ = *std::move(last);
+  // A committed move stays committed: this copy must not take writes the new owner will not see.
+  if (auto to = options.env->ReadFile(MovedToPath(dir)); to.ok()) {
+    base::MutexLock lock(&store->queue_mutex_);
+    store->move_ = MoveStatus{MoveState::kMoved, *std::move(to)};
+  } else if (!absl::IsNotFound(to.status())) {
+    return to.status();
+  }
   store->workers_ = std::make_unique<ShardWorkers>(info.shards, "fremen-shard");
   store->committer_ = std::thread([s = store.get()] { s->CommitLoop(); });
   store->applier_ = std::thread([s = store.get()] { s->ApplyLoop(); });
@@ -242,6 +254,7 @@ absl::Status MapStoreImpl::Submit(ObservationBatch batch, AckCallback done) {
   const auto refusal = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(queue_mutex_) -> absl::Status {
     if (closing_) return absl::UnavailableError(absl::StrCat("map ", info_.name, " is closing"));
     if (!write_error_.ok()) return write_error_;
+    if (move_.state != MoveState::kServing) return MovingError(info_.name);
     if (!FitsLocked(n)) {
       absl::Status full = absl::ResourceExhaustedError(
           absl::StrCat("map ", info_.name, " is behind on ingest: too many queued observations; retry"));
@@ -270,7 +283,7 @@ absl::Status MapStoreImpl::Submit(ObservationBatch batch, AckCallback done) {
 void MapStoreImpl::OnRoom(uint64_t observations, std::function<void()> f) {
   {
     base::MutexLock lock(&queue_mutex_);
-    if (!FitsLocked(observations) && !closing_ && write_error_.ok()) {
+    if (!FitsLocked(observations) && !closing_ && write_error_.ok() && move_.state == MoveState::kServing) {
       room_waiters_.push_back(std::move(f));
       return;
     }
@@ -311,6 +324,10 @@ absl::StatusOr<uint64_t> MapStoreImpl::RunControl(Control::Kind kind, std::funct
 absl::Status MapStoreImpl::Checkpoint() { return RunControl(Control::Kind::kCheckpoint).status(); }
 
 absl::StatusOr<uint64_t> MapStoreImpl::PublishModels(std::function<void(uint64_t, uint64_t)> progress) {
+  {
+    base::MutexLock lock(&queue_mutex_);
+    if (move_.state != MoveState::kServing) return MovingError(info_.name);
+  }
   return RunControl(Control::Kind::kPublish, std::move(progress));
 }
 
@@ -337,6 +354,46 @@ absl::Status MapStoreImpl::Close() {
 absl::Status MapStoreImpl::WriteError() const {
   base::MutexLock lock(&queue_mutex_);
   return write_error_;
+}
+
+absl::Status MapStoreImpl::StopWrites() {
+  std::vector<std::function<void()>> room;
+  {
+    base::MutexLock lock(&queue_mutex_);
+    if (move_.state == MoveState::kServing) move_.state = MoveState::kWritesStopped;
+    room.swap(room_waiters_);
+  }
+  // As after a latched error: waiters resubmit and learn that the map is moving.
+  for (auto& f : room) f();
+  // Queued before the refusal: the checkpoint runs after them, so they are applied and answered.
+  return Checkpoint();
+}
+
+absl::Status MapStoreImpl::ResumeWrites() {
+  base::MutexLock lock(&queue_mutex_);
+  if (move_.state == MoveState::kMoved) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("map ", info_.name, " has moved to ", move_.moved_to, "; delete this copy instead"));
+  }
+  move_.state = MoveState::kServing;
+  return absl::OkStatus();
+}
+
+absl::Status MapStoreImpl::MarkMoved(const std::string& to) {
+  base::MutexLock lock(&queue_mutex_);
+  if (move_.state == MoveState::kMoved) return absl::OkStatus();
+  if (move_.state != MoveState::kWritesStopped) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("map ", info_.name, " takes writes: stop them before the move is committed"));
+  }
+  if (absl::Status s = WriteFileAtomically(options_.env, MovedToPath(dir_), to); !s.ok()) return s;
+  move_ = MoveStatus{MoveState::kMoved, to};
+  return absl::OkStatus();
+}
+
+MoveStatus MapStoreImpl::Move() const {
+  base::MutexLock lock(&queue_mutex_);
+  return move_;
 }
 
 void MapStoreImpl::Latch(const absl::Status& status) {
@@ -750,6 +807,13 @@ absl::StatusOr<uint64_t> MapStoreImpl::Backup(const std::string& dir) {
     if (absl::Status s = shards_[i]->env().CopyTo(ShardDir(dir, i)); !s.ok()) return s;
   }
   if (absl::Status s = WriteFileAtomically(options_.env, dir + "/map.info", EncodeMapInfo(info_)); !s.ok()) return s;
+  {
+    // The last update job's record comes along, so that a restored (or moved) map reports it.
+    base::MutexLock lock(&last_update_mutex_);
+    if (last_update_) {
+      if (absl::Status s = WriteUpdateRecord(options_.env, LastUpdatePath(dir), *last_update_); !s.ok()) return s;
+    }
+  }
   uint64_t bytes = 0;
   std::error_code error;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(dir, error)) {

@@ -44,6 +44,10 @@ class MapStoreImpl final : public MapStore {
   absl::Status RecordUpdate(const UpdateRecord& record) override ABSL_LOCKS_EXCLUDED(last_update_mutex_);
   absl::Status Close() override ABSL_LOCKS_EXCLUDED(queue_mutex_);
   absl::Status WriteError() const override ABSL_LOCKS_EXCLUDED(queue_mutex_);
+  absl::Status StopWrites() override ABSL_LOCKS_EXCLUDED(queue_mutex_);
+  absl::Status ResumeWrites() override ABSL_LOCKS_EXCLUDED(queue_mutex_);
+  absl::Status MarkMoved(const std::string& to) override ABSL_LOCKS_EXCLUDED(queue_mutex_);
+  MoveStatus Move() const override ABSL_LOCKS_EXCLUDED(queue_mutex_);
 
   std::vector<float> Predict(std::span<const uint64_t> keys, std::span<const double> times,
                              const PredictOptions& options) const override;
@@ -168,6 +172,8 @@ class MapStoreImpl final : public MapStore {
   std::vector<std::function<void()>> room_waiters_ ABSL_GUARDED_BY(queue_mutex_);
   // Latched: a failed log sync or checkpoint stops all writes.
   absl::Status write_error_ ABSL_GUARDED_BY(queue_mutex_);
+  // A move (StopWrites, MarkMoved): writes refused while not kServing.
+  MoveStatus move_ ABSL_GUARDED_BY(queue_mutex_);
 
   // Guards no member: held by checkpoints and backups, so that a backup sees one checkpoint.
   base::Mutex backup_mutex_;

@@ -411,5 +411,36 @@ TEST(MapStoreTest, StatesPastTheWideningLimitFoldInDoubleAndRecoverExactly) {
   ExpectSameModels(*store, *reference, map);
 }
 
+// A move (docs/fleet.md, "Moving a map"): stopped writes are refused retryably with the move's
+// message and everything submitted before is applied; a committed move outlives a reopen.
+TEST(MapStoreTest, AMapThatMovesRefusesWritesRetryablyAndKeepsACommittedMove) {
+  TempDir dir;
+  const MapInfo map = GridMap("m", 16, 16, 1, 2);
+  {
+    auto store = OpenOrDie(map, dir.path());
+    ASSERT_TRUE(store->Write(SweepScan(map, 1, 0, 100)).ok());
+    EXPECT_TRUE(absl::IsFailedPrecondition(store->MarkMoved("b:1")));  // writes not stopped yet
+    ASSERT_TRUE(store->StopWrites().ok());
+    EXPECT_EQ(store->Move().state, MoveState::kWritesStopped);
+    EXPECT_EQ(store->Stats().totals.observations, 100u);
+    const absl::Status refused = store->Write(SweepScan(map, 2, 0, 100)).status();
+    EXPECT_TRUE(absl::IsUnavailable(refused)) << refused;
+    EXPECT_EQ(refused.message(), "map m is moving to another daemon; retry");
+    EXPECT_TRUE(absl::IsUnavailable(store->PublishModels().status()));
+    EXPECT_EQ(store->Predict(std::vector<uint64_t>{0}, std::vector<double>{1}, {}).size(), 1u);  // reads go on
+    ASSERT_TRUE(store->ResumeWrites().ok());
+    ASSERT_TRUE(store->Write(SweepScan(map, 2, 0, 100)).ok());
+    ASSERT_TRUE(store->StopWrites().ok());
+    ASSERT_TRUE(store->MarkMoved("b:1").ok());
+    EXPECT_TRUE(store->MarkMoved("c:1").ok());  // idempotent: the first target stays
+    EXPECT_TRUE(absl::IsFailedPrecondition(store->ResumeWrites()));
+  }
+  auto reopened = OpenOrDie(map, dir.path());
+  EXPECT_EQ(reopened->Move().state, MoveState::kMoved);
+  EXPECT_EQ(reopened->Move().moved_to, "b:1");
+  EXPECT_TRUE(absl::IsUnavailable(reopened->Write(SweepScan(map, 3, 0, 100)).status()));
+  EXPECT_EQ(reopened->Stats().totals.observations, 200u);
+}
+
 }  // namespace
 }  // namespace fremen::storage

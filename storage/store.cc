@@ -231,6 +231,8 @@ absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::str
     fs::create_directories(to, error);
     if (!error) fs::copy_file(from + "/data.mdb", to + "/data.mdb", error);
   }
+  // Only a report (the last update job's record): a backup without one restores without one.
+  if (!error && fs::exists(dir + "/last_update")) fs::copy_file(dir + "/last_update", target + "/last_update", error);
   if (error) {
     (void)catalog_->Delete(created->name);
     std::error_code ignored;

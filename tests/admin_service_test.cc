@@ -670,13 +670,7 @@ TEST_F(AdminServiceTest, LosslessMapUpdateSelectsOrdersAndReconstructsExactly) {
   }
   v1::ReconstructRequest request;
   request.set_map("hall");
-  for (uint32_t y = 0; y < kNy; ++y) {
-    for (uint32_t x = 0; x < kNx; ++x) {
-      request.mutable_states()->mutable_cells()->add_x(x);
-      request.mutable_states()->mutable_cells()->add_y(y);
-      request.mutable_states()->mutable_cells()->add_z(0);
-    }
-  }
+  *request.mutable_states() = PlaneCells(kNx, kNy);
   request.set_start_time(kT0);
   request.set_end_time(kT0 + kDelta * kSlots);
   v1::ReconstructResponse past;

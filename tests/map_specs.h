@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "fremen/v1/common.pb.h"
 #include "fremen/v1/maps.pb.h"
 
 namespace fremen::testing {
@@ -28,6 +29,19 @@ inline v1::Map GenericMapSpec(const std::string& name) {
   map.set_name(name);
   map.set_kind(v1::MAP_KIND_GENERIC);
   return map;
+}
+
+// Every cell of an nx × ny plane (z = 0), x fastest: the states of a request about a whole grid.
+inline v1::StateRefs PlaneCells(uint32_t nx, uint32_t ny) {
+  v1::StateRefs refs;
+  for (uint32_t y = 0; y < ny; ++y) {
+    for (uint32_t x = 0; x < nx; ++x) {
+      refs.mutable_cells()->add_x(x);
+      refs.mutable_cells()->add_y(y);
+      refs.mutable_cells()->add_z(0);
+    }
+  }
+  return refs;
 }
 
 }  // namespace fremen::testing

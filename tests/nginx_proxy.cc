@@ -13,6 +13,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "tests/fremend_fixture.h"
 #include "tests/process_runner.h"
 
@@ -44,9 +45,12 @@ std::vector<std::string> NginxArgs(const std::string& dir, const std::string& co
 
 std::string NginxBinary() { return access("/usr/sbin/nginx", X_OK) == 0 ? "/usr/sbin/nginx" : ""; }
 
-absl::StatusOr<std::string> RenderNginxConfig(const std::string& dir, const std::vector<ProxiedDaemon>& daemons,
-                                              const std::string& grpc_listen, const std::string& http_listen) {
-  const std::string config = absl::StrCat(dir, "/nginx.conf");
+namespace {
+
+// render.py's arguments (after the interpreter) for `daemons`, writing `config`.
+std::vector<std::string> RenderArgs(const std::string& dir, const std::vector<ProxiedDaemon>& daemons,
+                                    const std::string& grpc_listen, const std::string& http_listen,
+                                    const std::string& config) {
   std::vector<std::string> args = {absl::StrCat(FREMEN_SOURCE_DIR, "/deploy/nginx/render.py"),
                                    "--grpc-listen",
                                    grpc_listen,
@@ -57,6 +61,15 @@ absl::StatusOr<std::string> RenderNginxConfig(const std::string& dir, const std:
                                    "--out",
                                    config};
   for (const ProxiedDaemon& d : daemons) args.insert(args.end(), {"--daemon", absl::StrCat(d.grpc, "=", d.http)});
+  return args;
+}
+
+}  // namespace
+
+absl::StatusOr<std::string> RenderNginxConfig(const std::string& dir, const std::vector<ProxiedDaemon>& daemons,
+                                              const std::string& grpc_listen, const std::string& http_listen) {
+  const std::string config = absl::StrCat(dir, "/nginx.conf");
+  const std::vector<std::string> args = RenderArgs(dir, daemons, grpc_listen, http_listen, config);
   const RunResult rendered = RunProgram("/usr/bin/python3", args);
   if (rendered.exit_code != 0) {
     return absl::InternalError(absl::StrCat("render.py: ", Describe(rendered), ": ", rendered.err));
@@ -71,14 +84,15 @@ absl::StatusOr<std::string> RenderNginxConfig(const std::string& dir, const std:
 }
 
 absl::StatusOr<std::unique_ptr<NginxProxy>> NginxProxy::Start(const std::string& dir,
-                                                              const std::vector<ProxiedDaemon>& daemons) {
+                                                              const std::vector<ProxiedDaemon>& daemons,
+                                                              bool master_process) {
   const std::string grpc_address = FreeLoopbackAddress();
   const std::string http_address = FreeLoopbackAddress();
   auto config = RenderNginxConfig(dir, daemons, grpc_address, http_address);
   if (!config.ok()) return config.status();
   std::vector<std::string> args = NginxArgs(dir, *config);
-  // One process in the foreground: killed with the test (PDEATHSIG), no worker left behind.
-  args.insert(args.end(), {"-g", "daemon off; master_process off;"});
+  // In the foreground: killed with the test (PDEATHSIG). One process, unless the test reloads it.
+  args.insert(args.end(), {"-g", master_process ? "daemon off;" : "daemon off; master_process off;"});
   const std::string out_path = absl::StrCat(dir, "/nginx.out");
   const pid_t pid = SpawnBackground(NginxBinary(), args, out_path);
   if (pid < 0) return absl::InternalError("fork failed");
@@ -116,6 +130,16 @@ std::string NginxProxy::AccessLog(size_t lines) const {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
 }
+std::string NginxProxy::ReloadCommand(const std::vector<ProxiedDaemon>& daemons) const {
+  const std::string config = absl::StrCat(dir_, "/nginx.conf");
+  std::vector<std::string> render = RenderArgs(dir_, daemons, grpc_address_, http_address_, config);
+  render.insert(render.begin(), "/usr/bin/python3");
+  std::vector<std::string> reload = NginxArgs(dir_, config);
+  reload.insert(reload.begin(), NginxBinary());
+  reload.insert(reload.end(), {"-s", "reload"});
+  return absl::StrCat(absl::StrJoin(render, " "), " && ", absl::StrJoin(reload, " "));
+}
+
 std::string NginxProxy::ErrorLog() const { return ReadTextFile(absl::StrCat(dir_, "/error.log")); }
 
 }  // namespace fremen::testing

@@ -5,7 +5,11 @@
 // NginxProxy::Start renders the configuration into a directory the test owns (pid file, logs,
 // temporary files there too), runs `nginx -t` on it, then nginx in the foreground as one process
 // (master_process off: it dies with the test process, like the daemons of fremend_fixture.h), and
-// returns once its gRPC port accepts connections. The test is skipped when nginx is not installed
+// returns once its gRPC port accepts connections. A test that reconfigures the proxy (a rebalance)
+// starts it with a master process and one worker instead, as nginx runs in production: a reload
+// then starts a new worker with the new configuration and the old one closes its connections
+// gracefully (HTTP/2 GOAWAY), so that clients' next calls take the new routes; in one process a
+// reload would leave open connections on the old configuration. The test is skipped when nginx is not installed
 // (scripts/install-deps.sh installs nginx-light).
 // Thread-compatible: one test thread drives a proxy.
 #pragma once
@@ -38,7 +42,8 @@ class NginxProxy {
  public:
   // `dir` must exist; the proxy listens on free loopback ports.
   static absl::StatusOr<std::unique_ptr<NginxProxy>> Start(const std::string& dir,
-                                                           const std::vector<ProxiedDaemon>& daemons);
+                                                           const std::vector<ProxiedDaemon>& daemons,
+                                                           bool master_process = false);
   // Stops nginx (SIGTERM) and waits.
   ~NginxProxy();
 
@@ -50,6 +55,9 @@ class NginxProxy {
   std::string AccessLog(size_t lines = 0) const;
   // Its error log so far.
   std::string ErrorLog() const;
+  // A shell command that renders the configuration for `daemons` over this proxy's (same listen
+  // addresses and directory) and reloads nginx (`nginx -s reload`): a rebalance's --proxy-command.
+  std::string ReloadCommand(const std::vector<ProxiedDaemon>& daemons) const;
 
  private:
   NginxProxy(pid_t pid, std::string dir, std::string grpc_address, std::string http_address)

@@ -19,11 +19,7 @@ namespace {
 // Backups copy whole maps: the global --timeout (meant for queries) is raised to at least this.
 constexpr double kMinBackupSeconds = 600;
 
-CallOptions BackupCall() {
-  CallOptions call = GlobalCall();
-  call.timeout = std::max(*call.timeout, absl::Seconds(kMinBackupSeconds));
-  return call;
-}
+CallOptions BackupCall() { return GlobalCallOfAtLeast(absl::Seconds(kMinBackupSeconds)); }
 
 // The daemon's message for a bad backup directory, with what it means on this side.
 absl::Status ExplainDirectory(const absl::Status& status) {

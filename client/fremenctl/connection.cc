@@ -1,5 +1,6 @@
 #include "client/fremenctl/connection.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -43,6 +44,10 @@ void AddGlobalOptions(CLI::App& app) {
 }
 
 CallOptions GlobalCall() { return CallOptions{.timeout = absl::Seconds(Globals().timeout_seconds)}; }
+
+CallOptions GlobalCallOfAtLeast(absl::Duration minimum) {
+  return CallOptions{.timeout = std::max(absl::Seconds(Globals().timeout_seconds), minimum)};
+}
 
 std::vector<std::string> Addresses() { return SplitAddressList(Globals().address); }
 

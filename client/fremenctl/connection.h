@@ -55,6 +55,9 @@ FleetClient ConnectFleetOrExit(absl::string_view command, const std::vector<std:
 
 // The per-call options of the global --timeout.
 CallOptions GlobalCall();
+// The same with the timeout raised to at least `minimum`: calls that copy whole maps (the global
+// --timeout is meant for queries).
+CallOptions GlobalCallOfAtLeast(absl::Duration minimum);
 
 // Reports on stderr — "fremenctl COMMAND: WHAT: MESSAGE" and a hint for the status code — and ends
 // the command with kExitFailure (throws CLI::RuntimeError). `map`, when set, is the map the call

@@ -23,6 +23,7 @@
 #include "client/fremenctl/exit_codes.h"
 #include "client/fremenctl/fleet_maps.h"
 #include "client/lib/fleet_addresses.h"
+#include "client/fremenctl/fleet_move.h"
 #include "client/lib/placement.h"
 
 namespace fremen::client {
@@ -86,7 +87,7 @@ void RunPlacement(const PlacementArgs& a) {
 }  // namespace
 
 void RegisterFleetCommand(CLI::App& app) {
-  CLI::App* fleet = app.add_subcommand("fleet", "A fleet of daemons behind a proxy: which daemon holds which map");
+  CLI::App* fleet = app.add_subcommand("fleet", "A fleet of daemons behind a proxy: which daemon holds which map, moving maps");
   fleet->require_subcommand(1);
   auto a = std::make_shared<PlacementArgs>();
   CLI::App* placement = fleet->add_subcommand(
@@ -102,6 +103,7 @@ void RegisterFleetCommand(CLI::App& app) {
       "answer.\nThe names must be the proxy's server strings exactly: nginx hashes the string, port included "
       "(docs/fleet.md).");
   placement->callback([a] { RunPlacement(*a); });
+  RegisterFleetMoveCommands(*fleet);
 }
 
 }  // namespace fremen::client

@@ -17,6 +17,7 @@
 #include "client/fremenctl/query_commands.h"
 #include "client/fremenctl/region_command.h"
 #include "client/fremenctl/salvage_command.h"
+#include "client/fremenctl/transfer_commands.h"
 #include "client/fremenctl/update_command.h"
 
 int main(int argc, char** argv) {
@@ -36,6 +37,8 @@ int main(int argc, char** argv) {
   fremen::client::RegisterOperationsCommand(app);
   fremen::client::RegisterBackupCommand(app);
   fremen::client::RegisterRestoreCommand(app);
+  fremen::client::RegisterExportCommand(app);
+  fremen::client::RegisterImportCommand(app);
   fremen::client::RegisterStatusCommand(app);
   fremen::client::RegisterCheckCommand(app);
   fremen::client::RegisterSalvageCommand(app);

@@ -185,6 +185,26 @@ class Client {
   absl::StatusOr<v1::SalvageMapResponse> SalvageMap(absl::string_view map, absl::string_view new_map = "",
                                                     const CallOptions& call = {}) const;
 
+  // --- a map's copy as a stream, and moves (docs/fleet.md, "Moving a map") ---
+  // The map's export (header, data chunks, trailer): `receive` is called with each message in
+  // order; a non-OK answer cancels the stream and is returned. Tried once. chunk_bytes 0: 1 MiB.
+  absl::Status ExportMap(absl::string_view map, const std::function<absl::Status(const v1::MapChunk&)>& receive,
+                         const CallOptions& call = {}, uint32_t chunk_bytes = 0) const;
+  // An export as a new map: `next` fills the next message and answers true, or false once the
+  // trailer has been given; an error cancels the stream and is returned. `map` is the header's
+  // map (sent as x-fremen-map, so that a proxy routes the call to its owner). Tried once.
+  absl::StatusOr<v1::ImportMapResponse> ImportMap(absl::string_view map,
+                                                  const std::function<absl::StatusOr<bool>(v1::MapChunk&)>& next,
+                                                  const CallOptions& call = {}) const;
+  // ExportMap of `map` here streamed straight into ImportMap on `target`, as `new_name` (empty:
+  // the same name).
+  absl::StatusOr<v1::ImportMapResponse> CopyMapTo(const Client& target, absl::string_view map,
+                                                  absl::string_view new_name = "", const CallOptions& call = {}) const;
+  // A step of a move on the daemon that holds the map (AdminService.SetMapMove). Each step is
+  // idempotent, so it is retried.
+  absl::StatusOr<v1::SetMapMoveResponse> SetMapMove(absl::string_view map, v1::MapMoveStep step,
+                                                    absl::string_view to = "", const CallOptions& call = {}) const;
+
  private:
   std::shared_ptr<Connection> connection_;
 };

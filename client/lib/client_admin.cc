@@ -2,6 +2,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "client/lib/client.h"
+#include "client/lib/status.h"
 
 namespace fremen::client {
 
@@ -134,6 +135,104 @@ absl::StatusOr<v1::SalvageMapResponse> Client::SalvageMap(absl::string_view map,
   v1::SalvageMapResponse response;
   absl::Status status = connection_->CallOnce(call, map, [&](grpc::ClientContext& context) {
     return connection_->admin().SalvageMap(&context, request, &response);
+  });
+  if (!status.ok()) return status;
+  return response;
+}
+
+absl::Status Client::ExportMap(absl::string_view map,
+                              const std::function<absl::Status(const v1::MapChunk&)>& receive,
+                              const CallOptions& call, uint32_t chunk_bytes) const {
+  v1::ExportMapRequest request;
+  request.set_map(std::string(map));
+  request.set_chunk_bytes(chunk_bytes);
+  absl::Status refused;
+  absl::Status status = connection_->CallOnce(call, map, [&](grpc::ClientContext& context) {
+    auto reader = connection_->admin().ExportMap(&context, request);
+    v1::MapChunk chunk;
+    while (reader->Read(&chunk)) {
+      refused = receive(chunk);
+      if (!refused.ok()) {
+        context.TryCancel();
+        while (reader->Read(&chunk)) {
+        }
+        break;
+      }
+    }
+    return reader->Finish();
+  });
+  return refused.ok() ? status : refused;
+}
+
+absl::StatusOr<v1::ImportMapResponse> Client::ImportMap(
+    absl::string_view map, const std::function<absl::StatusOr<bool>(v1::MapChunk&)>& next,
+    const CallOptions& call) const {
+  v1::ImportMapResponse response;
+  absl::Status local;
+  absl::Status status = connection_->CallOnce(call, map, [&](grpc::ClientContext& context) {
+    auto writer = connection_->admin().ImportMap(&context, &response);
+    v1::MapChunk chunk;
+    for (;;) {
+      absl::StatusOr<bool> more = next(chunk);
+      if (!more.ok()) {
+        // Nothing may be created from a stream cut short on this side.
+        local = more.status();
+        context.TryCancel();
+        break;
+      }
+      if (!*more) break;
+      if (!writer->Write(chunk)) break;  // the daemon has ended the call: Finish says why
+    }
+    if (local.ok()) writer->WritesDone();
+    return writer->Finish();
+  });
+  if (!local.ok()) return local;
+  if (!status.ok()) return status;
+  return response;
+}
+
+absl::StatusOr<v1::ImportMapResponse> Client::CopyMapTo(const Client& target, absl::string_view map,
+                                                        absl::string_view new_name, const CallOptions& call) const {
+  const std::string name(new_name.empty() ? map : new_name);
+  v1::ExportMapRequest request;
+  request.set_map(std::string(map));
+  auto context = connection_->NewContext(connection_->DeadlineOf(call), map);
+  auto reader = connection_->admin().ExportMap(context.get(), request);
+  bool ended = false;
+  auto imported = target.ImportMap(
+      name,
+      [&](v1::MapChunk& chunk) -> absl::StatusOr<bool> {
+        if (ended) return false;
+        if (!reader->Read(&chunk)) {
+          // The export ended: after its trailer (the importer has it), or failed.
+          ended = true;
+          absl::Status exported = FromGrpcStatus(reader->Finish(), connection_->address());
+          if (!exported.ok()) return exported;
+          return false;
+        }
+        if (chunk.has_header()) chunk.mutable_header()->set_map(name);
+        return true;
+      },
+      call);
+  if (!ended) {
+    context->TryCancel();
+    v1::MapChunk rest;
+    while (reader->Read(&rest)) {
+    }
+    (void)reader->Finish();
+  }
+  return imported;
+}
+
+absl::StatusOr<v1::SetMapMoveResponse> Client::SetMapMove(absl::string_view map, v1::MapMoveStep step,
+                                                          absl::string_view to, const CallOptions& call) const {
+  v1::SetMapMoveRequest request;
+  request.set_map(std::string(map));
+  request.set_step(step);
+  request.set_to(std::string(to));
+  v1::SetMapMoveResponse response;
+  absl::Status status = connection_->CallIdempotent(call, map, [&](grpc::ClientContext& context) {
+    return connection_->admin().SetMapMove(&context, request, &response);
   });
   if (!status.ok()) return status;
   return response;

@@ -135,4 +135,16 @@ void MapInfoToProto(const storage::MapInfo& info, v1::Map& out) {
   out.mutable_create_time()->set_seconds(info.created_unix);
 }
 
+v1::MapMoveState MoveStateToProto(storage::MoveState state) {
+  switch (state) {
+    case storage::MoveState::kServing:
+      return v1::MAP_MOVE_STATE_SERVING;
+    case storage::MoveState::kWritesStopped:
+      return v1::MAP_MOVE_STATE_WRITES_STOPPED;
+    case storage::MoveState::kMoved:
+      return v1::MAP_MOVE_STATE_MOVED;
+  }
+  return v1::MAP_MOVE_STATE_UNSPECIFIED;
+}
+
 }  // namespace fremen::server

@@ -8,6 +8,7 @@
 #include "absl/status/statusor.h"
 #include "fremen/v1/maps.pb.h"
 #include "storage/map_info.h"
+#include "storage/map_store.h"
 
 namespace fremen::server {
 
@@ -16,6 +17,9 @@ absl::StatusOr<storage::MapInfo> MapInfoFromProto(const v1::Map& map);
 
 // Every field set, defaults included.
 void MapInfoToProto(const storage::MapInfo& info, v1::Map& out);
+
+// A map's move state (docs/fleet.md, "Moving a map").
+v1::MapMoveState MoveStateToProto(storage::MoveState state);
 
 // A storage validation error with storage's field names replaced by the proto's.
 absl::Status RenameStorageFields(const absl::Status& status);

@@ -12,6 +12,7 @@
 #include "server/rpc/logging.h"
 #include "server/convert/map_convert.h"
 #include "server/jobs/map_list.h"
+#include "server/rpc/map_lookup.h"
 #include "server/rpc/map_name.h"
 #include "server/convert/operation_convert.h"
 #include "server/convert/query_convert.h"
@@ -33,6 +34,9 @@ constexpr MethodSpec kRestoreMap{"RestoreMap", Access::kWrite, /*blocking=*/true
 constexpr MethodSpec kGetServerStatus{"GetServerStatus", Access::kRead, /*blocking=*/true};
 constexpr MethodSpec kCheckMap{"CheckMap", Access::kRead, /*blocking=*/true};
 constexpr MethodSpec kSalvageMap{"SalvageMap", Access::kWrite, /*blocking=*/true};
+constexpr MethodSpec kExportMap{"ExportMap", Access::kWrite, /*blocking=*/true};
+constexpr MethodSpec kImportMap{"ImportMap", Access::kWrite, /*blocking=*/true};
+constexpr MethodSpec kSetMapMove{"SetMapMove", Access::kWrite, /*blocking=*/true};
 
 constexpr char kOperationPrefix[] = "operations/";
 
@@ -126,9 +130,10 @@ grpc::ServerUnaryReactor* AdminServiceImpl::RunUpdate(grpc::CallbackServerContex
   return ServeUnary(deps_, context, kRunUpdate, [this, context, request, response]() -> absl::Status {
     auto name = ResolveMapName(*context, request->map(), "map");
     if (!name.ok()) return name.status();
-    auto store = deps_.store->Get();
-    if (!store.ok()) return store.status();
-    if (auto info = (*store)->GetMap(*name); !info.ok()) return info.status();
+    auto map = LookUpMap(*deps_.store, *context, *name);
+    if (!map.ok()) return map.status();
+    // The job's publication would be refused anyway; the caller learns it now, as a retry.
+    if ((*map)->Move().state != storage::MoveState::kServing) return storage::MovingError(*name);
     auto op = admin_.operations->StartUpdate(*name, "RunUpdate");
     if (!op.ok()) return op.status();
     OperationToProto(*op, *response);
@@ -346,6 +351,120 @@ grpc::ServerUnaryReactor* AdminServiceImpl::SalvageMap(grpc::CallbackServerConte
     }
     return absl::OkStatus();
   });
+}
+
+grpc::ServerWriteReactor<v1::MapChunk>* AdminServiceImpl::ExportMap(grpc::CallbackServerContext* context,
+                                                                    const v1::ExportMapRequest* request) {
+  return ServeServerStream<v1::MapChunk>(
+      deps_, context, kExportMap, [this, context, request](StreamWriter<v1::MapChunk>& out) -> absl::Status {
+        auto name = ResolveMapName(*context, request->map(), "map");
+        if (!name.ok()) return name.status();
+        auto store = deps_.store->Get();
+        if (!store.ok()) return store.status();
+        const absl::Time start = admin_.clock->Now();
+        uint64_t bytes = 0;
+        const absl::Status status = server::ExportMap(
+            **store, *name, admin_.config->data_dir, request->chunk_bytes(), [&](const v1::MapChunk& chunk) {
+              bytes += chunk.data().data().size();
+              return out.Write(chunk);
+            });
+        if (status.ok()) {
+          DaemonLog()->info("export of map {}: {} bytes in {}", *name, bytes,
+                            absl::FormatDuration(admin_.clock->Now() - start));
+        }
+        return status;
+      });
+}
+
+grpc::ServerReadReactor<v1::MapChunk>* AdminServiceImpl::ImportMap(grpc::CallbackServerContext* context,
+                                                                   v1::ImportMapResponse* response) {
+  return ServeClientStream<v1::MapChunk>(
+      deps_, context, kImportMap, response,
+      [this, context](StreamReader<v1::MapChunk>& in, v1::ImportMapResponse& out) {
+        return Import(in, *context, out);
+      });
+}
+
+absl::Status AdminServiceImpl::Import(StreamReader<v1::MapChunk>& in, const grpc::CallbackServerContext& context,
+                                      v1::ImportMapResponse& response) const {
+  const absl::Time start = admin_.clock->Now();
+  auto store = deps_.store->Get();
+  if (!store.ok()) return store.status();
+  auto staging = NewTransferDir(admin_.config->data_dir, "import");
+  if (!staging.ok()) return staging.status();
+  MapImportWriter writer(*staging);
+  const auto import = [&]() -> absl::StatusOr<storage::MapInfo> {
+    v1::MapChunk chunk;
+    std::string name;
+    while (in.Read(chunk)) {
+      if (absl::Status added = writer.Add(chunk); !added.ok()) return added;
+      if (chunk.has_header()) {
+        // Refused before the data is sent: the name is known from the first message.
+        auto resolved = ResolveMapName(context, chunk.header().map(), "header.map");
+        if (!resolved.ok()) return resolved.status();
+        name = *std::move(resolved);
+        if (auto existing = (*store)->GetMap(name); existing.ok() || !absl::IsNotFound(existing.status())) {
+          if (!existing.ok()) return existing.status();
+          return absl::AlreadyExistsError(absl::StrCat("map \"", name, "\" already exists"));
+        }
+      }
+    }
+    if (context.IsCancelled()) return absl::CancelledError("ImportMap: the client cancelled the stream");
+    if (absl::Status finished = writer.Finish(); !finished.ok()) return finished;
+    return (*store)->RestoreMap(writer.dir(), name, CallDeadline(context));
+  };
+  auto info = import();
+  std::error_code error;
+  fs::remove_all(*staging, error);
+  if (!info.ok()) {
+    DaemonLog()->warn("import refused: {}", info.status().ToString());
+    return RenameNameField(info.status(), "header.map");
+  }
+  MapInfoToProto(*info, *response.mutable_map());
+  response.set_bytes(writer.bytes());
+  const absl::Duration took = admin_.clock->Now() - start;
+  response.set_duration_seconds(absl::ToDoubleSeconds(took));
+  DaemonLog()->info("map {} imported: {} bytes in {}", info->name, writer.bytes(), absl::FormatDuration(took));
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* AdminServiceImpl::SetMapMove(grpc::CallbackServerContext* context,
+                                                       const v1::SetMapMoveRequest* request,
+                                                       v1::SetMapMoveResponse* response) {
+  return ServeUnary(deps_, context, kSetMapMove, [this, context, request, response] {
+    return Move(*request, *context, *response);
+  });
+}
+
+absl::Status AdminServiceImpl::Move(const v1::SetMapMoveRequest& request, const grpc::CallbackServerContext& context,
+                                    v1::SetMapMoveResponse& response) const {
+  auto map = LookUpMap(*deps_.store, context, request.map());
+  if (!map.ok()) return map.status();
+  const std::string& name = (*map)->info().name;
+  absl::Status status;
+  switch (request.step()) {
+    case v1::MAP_MOVE_STEP_STOP_WRITES:
+      status = (*map)->StopWrites();
+      if (status.ok()) DaemonLog()->info("map {}: writes stopped for a move", name);
+      break;
+    case v1::MAP_MOVE_STEP_MOVED:
+      if (request.to().empty()) return absl::InvalidArgumentError("to: the daemon the map moved to is required");
+      status = (*map)->MarkMoved(request.to());
+      if (status.ok()) DaemonLog()->info("map {}: moved to {}; this copy refuses writes until deleted", name, request.to());
+      break;
+    case v1::MAP_MOVE_STEP_RESUME_WRITES:
+      status = (*map)->ResumeWrites();
+      if (status.ok()) DaemonLog()->info("map {}: writes resumed (no move)", name);
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("step: must be STOP_WRITES, MOVED or RESUME_WRITES, got ", v1::MapMoveStep_Name(request.step())));
+  }
+  if (!status.ok()) return status;
+  const storage::MoveStatus move = (*map)->Move();
+  response.set_state(MoveStateToProto(move.state));
+  response.set_moved_to(move.moved_to);
+  return absl::OkStatus();
 }
 
 grpc::ServerUnaryReactor* AdminServiceImpl::GetServerStatus(grpc::CallbackServerContext* context,

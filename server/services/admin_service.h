@@ -4,9 +4,11 @@
 // RunUpdate, GetOperation, ListOperations and CancelOperation only touch the operation registry and
 // the catalog, and run inline; BackupMap and RestoreMap copy files, CheckMap reads a whole map
 // (storage/verify.h), SalvageMap reads a damaged one and writes a new one (storage/salvage.h) and
-// GetServerStatus reads every map's statistics, so they run on the blocking pool. Write methods
-// (RunUpdate, CancelOperation, BackupMap, RestoreMap, SalvageMap) need a write token when tokens
-// are configured.
+// GetServerStatus reads every map's statistics, so they run on the blocking pool; so do ExportMap and
+// ImportMap, streams of a map's backup (server/services/map_transfer.h) served as loops on a pool
+// thread (server/rpc/blocking_stream.h), and SetMapMove, whose stop of writes waits for the queued
+// batches. Write methods (RunUpdate, CancelOperation, BackupMap, RestoreMap, SalvageMap, ExportMap,
+// ImportMap, SetMapMove) need a write token when tokens are configured.
 // Thread-safety: gRPC calls the handlers from any thread; the registry is thread-safe and the
 // service's one mutable member, the backups in progress, has its own mutex.
 #pragma once
@@ -22,6 +24,8 @@
 #include "server/daemon/config.h"
 #include "server/jobs/operations.h"
 #include "server/jobs/scrubber.h"
+#include "server/rpc/blocking_stream.h"
+#include "server/services/map_transfer.h"
 #include "server/rpc/unary_call.h"
 #include "server/jobs/update_scheduler.h"
 
@@ -40,7 +44,9 @@ struct AdminDeps {
 class AdminServiceImpl final : public v1::AdminService::CallbackService {
  public:
   AdminServiceImpl(const ServiceDeps& deps, const AdminDeps& admin)
-      : deps_(deps), admin_(admin), start_time_(admin.clock->Now()) {}
+      : deps_(deps), admin_(admin), start_time_(admin.clock->Now()) {
+    ClearTransfers(admin.config->data_dir);  // what a killed daemon left staged
+  }
 
   grpc::ServerUnaryReactor* RunUpdate(grpc::CallbackServerContext* context, const v1::RunUpdateRequest* request,
                                       v1::Operation* response) override;
@@ -63,6 +69,12 @@ class AdminServiceImpl final : public v1::AdminService::CallbackService {
                                      v1::CheckMapResponse* response) override;
   grpc::ServerUnaryReactor* SalvageMap(grpc::CallbackServerContext* context, const v1::SalvageMapRequest* request,
                                        v1::SalvageMapResponse* response) override;
+  grpc::ServerWriteReactor<v1::MapChunk>* ExportMap(grpc::CallbackServerContext* context,
+                                                    const v1::ExportMapRequest* request) override;
+  grpc::ServerReadReactor<v1::MapChunk>* ImportMap(grpc::CallbackServerContext* context,
+                                                   v1::ImportMapResponse* response) override;
+  grpc::ServerUnaryReactor* SetMapMove(grpc::CallbackServerContext* context, const v1::SetMapMoveRequest* request,
+                                       v1::SetMapMoveResponse* response) override;
 
  private:
   // The operation `name` (field "name"), checked against the map the call names, if any.
@@ -76,6 +88,10 @@ class AdminServiceImpl final : public v1::AdminService::CallbackService {
   absl::Status Restore(const v1::RestoreMapRequest& request, const grpc::CallbackServerContext& context,
                        v1::RestoreMapResponse& response) const;
   absl::Status FillStatus(v1::GetServerStatusResponse& response) const;
+  absl::Status Import(StreamReader<v1::MapChunk>& in, const grpc::CallbackServerContext& context,
+                      v1::ImportMapResponse& response) const;
+  absl::Status Move(const v1::SetMapMoveRequest& request, const grpc::CallbackServerContext& context,
+                    v1::SetMapMoveResponse& response) const;
 
   // Claims a backup directory for one call (false: another backup is writing there), so that two
   // concurrent backups never interleave in one directory.

@@ -22,6 +22,9 @@ grpc::ServerUnaryReactor* IngestServiceImpl::LastSequence(grpc::CallbackServerCo
   return ServeUnary(deps_, context, kLastSequence, [this, context, request, response]() -> absl::Status {
     auto map = LookUpMap(*deps_.store, *context, request->map());
     if (!map.ok()) return map.status();
+    // A writer asking where to continue is about to write: during a move, its answer is the new
+    // owner's.
+    if ((*map)->Move().state != storage::MoveState::kServing) return storage::MovingError((*map)->info().name);
     response->set_last_sequence((*map)->LastSequence(request->writer_id()));
     return absl::OkStatus();
   });

@@ -15,6 +15,15 @@ constexpr MethodSpec kGetMap{"GetMap", Access::kRead, /*blocking=*/false};
 constexpr MethodSpec kListMaps{"ListMaps", Access::kRead, /*blocking=*/false};
 constexpr MethodSpec kDeleteMap{"DeleteMap", Access::kWrite, /*blocking=*/true};
 
+// The map's move state (output only), from its open store; a failed map has none to tell.
+void AddMoveState(const storage::Store& store, v1::Map& map) {
+  auto open = store.Map(map.name());
+  if (!open.ok()) return;
+  const storage::MoveStatus move = (*open)->Move();
+  map.set_move_state(MoveStateToProto(move.state));
+  map.set_moved_to(move.moved_to);
+}
+
 }  // namespace
 
 grpc::ServerUnaryReactor* MapServiceImpl::CreateMap(grpc::CallbackServerContext* context,
@@ -32,6 +41,7 @@ grpc::ServerUnaryReactor* MapServiceImpl::CreateMap(grpc::CallbackServerContext*
     auto created = (*store)->CreateMap(*std::move(info));
     if (!created.ok()) return RenameStorageFields(created.status());
     MapInfoToProto(*created, *response->mutable_map());
+    AddMoveState(**store, *response->mutable_map());
     return absl::OkStatus();
   });
 }
@@ -46,6 +56,7 @@ grpc::ServerUnaryReactor* MapServiceImpl::GetMap(grpc::CallbackServerContext* co
     auto info = (*store)->GetMap(*name);
     if (!info.ok()) return info.status();
     MapInfoToProto(*info, *response->mutable_map());
+    AddMoveState(**store, *response->mutable_map());
     return absl::OkStatus();
   });
 }
@@ -63,7 +74,11 @@ grpc::ServerUnaryReactor* MapServiceImpl::ListMaps(grpc::CallbackServerContext* 
     if (!store.ok()) return store.status();
     auto page = (*store)->ListMaps(page_size, request->page_token());
     if (!page.ok()) return page.status();
-    for (const storage::MapInfo& info : page->maps) MapInfoToProto(info, *response->add_maps());
+    for (const storage::MapInfo& info : page->maps) {
+      v1::Map& map = *response->add_maps();
+      MapInfoToProto(info, map);
+      AddMoveState(**store, map);
+    }
     response->set_next_page_token(page->next_page_token);
     return absl::OkStatus();
   });

@@ -111,6 +111,21 @@ struct MapStats {
   std::optional<UpdateRecord> last_update;
 };
 
+// Where a map is in a move to another daemon (docs/fleet.md, "Moving a map").
+enum class MoveState {
+  kServing,        // takes writes
+  kWritesStopped,  // a move is copying it: writes refused, until ResumeWrites or MarkMoved
+  kMoved,          // the move is committed: writes refused for good (kept across a reopen)
+};
+struct MoveStatus {
+  MoveState state = MoveState::kServing;
+  std::string moved_to;  // kMoved: where it went
+};
+
+// The status writes get while a map moves (Unavailable: clients resend, and the proxy takes their
+// retries to the new owner once it routes there).
+absl::Status MovingError(const std::string& map);
+
 class MapStore {
  public:
   using AckCallback = std::function<void(absl::StatusOr<BatchAck>)>;
@@ -157,6 +172,20 @@ class MapStore {
   // is written after it either — the log holds every applied batch). Reads still work.
   virtual absl::Status WriteError() const = 0;
 
+  // --- moves (docs/fleet.md, "Moving a map") ---
+  // From now on Submit and PublishModels refuse with MovingError, and OnRoom's waiters are woken
+  // to learn it; returns once every batch submitted before is applied and acknowledged (a
+  // checkpoint), so that a backup taken next holds every acknowledged batch. Not kept across a
+  // reopen. Idempotent; OK once moved.
+  virtual absl::Status StopWrites() = 0;
+  // Takes writes again; FailedPrecondition once moved.
+  virtual absl::Status ResumeWrites() = 0;
+  // The move's commit: writes stay refused, across reopens (<dir>/moved_to, replaced atomically),
+  // until the map is deleted. FailedPrecondition unless writes are stopped (or it is moved already:
+  // then OK, `to` kept as first given).
+  virtual absl::Status MarkMoved(const std::string& to) = 0;
+  virtual MoveStatus Move() const = 0;
+
   // --- reads ---
   // p at every (time, key): out[i·keys + j] for times[i], keys[j].
   virtual std::vector<float> Predict(std::span<const uint64_t> keys, std::span<const double> times,
@@ -177,7 +206,8 @@ class MapStore {
                                                                        size_t n,
                                                                        const PredictOptions& options) const = 0;
   virtual MapStats Stats() const = 0;
-  // A consistent copy of every shard and the map's info into `dir` (created, must be empty).
+  // A consistent copy of every shard, the map's info and its last update record into `dir`
+  // (created, must be empty).
   // Returns the bytes written.
   virtual absl::StatusOr<uint64_t> Backup(const std::string& dir) = 0;
   // Verifies the map's files while it serves (storage/verify.h). Each shard is read in a forked

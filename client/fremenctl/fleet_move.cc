@@ -1,0 +1,341 @@
+#include "client/fremenctl/fleet_move.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "absl/time/clock.h"
+#include "client/fremenctl/connection.h"
+#include "client/fremenctl/exit_codes.h"
+#include "client/fremenctl/fleet_maps.h"
+#include "client/fremenctl/transfer_commands.h"
+#include "client/lib/placement.h"
+
+namespace fremen::client {
+
+namespace {
+
+struct MoveArgs {
+  std::string daemons;  // rebalance: the fleet after the change
+  std::string map, from, to;  // move
+  std::string proxy_command;
+  std::string proxy;
+  bool proxy_reloaded = false;
+  bool dry_run = false;
+};
+
+// One map to move, and what an earlier run left of it.
+struct Move {
+  std::string map, from, to;
+  bool committed = false;  // the source's copy is MOVED already
+  bool stale_target = false;  // the target holds a copy from a run that did not commit
+};
+
+// The daemons' clients, by address.
+class Fleet {
+ public:
+  Fleet(const std::string& command, const std::vector<std::string>& addresses)
+      : daemons_(ConnectEachOrExit(command, addresses)) {}
+  const Client& Of(const std::string& address) const {
+    for (const Daemon& d : daemons_) {
+      if (d.address == address) return d.client;
+    }
+    std::abort();  // every address was connected
+  }
+  const std::vector<Daemon>& daemons() const { return daemons_; }
+
+ private:
+  std::vector<Daemon> daemons_;
+};
+
+// The map's copy on one daemon, or nullopt when it holds none (or does not answer: an error).
+absl::StatusOr<std::optional<v1::Map>> CopyOn(const Client& client, const std::string& map) {
+  auto got = client.GetMap(map, GlobalCall());
+  if (absl::IsNotFound(got.status())) return std::nullopt;
+  if (!got.ok()) return got.status();
+  return *std::move(got);
+}
+
+std::string RenderHint(const std::vector<std::string>& daemons) {
+  std::string args;
+  for (const std::string& d : daemons) absl::StrAppend(&args, " --daemon ", d);
+  return absl::StrCat("deploy/nginx/render.py", args, " > nginx.conf && nginx -s reload");
+}
+
+class Mover {
+ public:
+  Mover(std::string command, const MoveArgs& args, const Fleet& fleet)
+      : command_(std::move(command)), args_(args), fleet_(fleet) {}
+
+  // Phases 1 to 4 (fleet_move.h) for `moves`; exits 1 when a phase fails.
+  void Run(std::vector<Move> moves, const std::vector<std::string>& new_daemons) {
+    if (moves.empty()) {
+      std::printf("nothing to move: every map is held by its owner\n");
+      return;
+    }
+    for (const Move& m : moves) {
+      std::printf("%s %s -> %s%s\n", m.map.c_str(), m.from.c_str(), m.to.c_str(),
+                  m.committed ? " (copied already: finishing)" : "");
+    }
+    if (args_.dry_run) return;
+    Copy(moves);
+    Commit(moves);
+    if (!args_.proxy_command.empty()) {
+      std::printf("reconfiguring the proxy: %s\n", args_.proxy_command.c_str());
+      std::fflush(stdout);
+      if (const int rc = std::system(args_.proxy_command.c_str()); rc != 0) {
+        Fail(absl::StrCat("--proxy-command exited with ", rc,
+                          "; the maps are on their new owners and their old copies refuse writes: fix the proxy, "
+                          "then run this again"));
+      }
+    } else if (!args_.proxy_reloaded) {
+      std::printf(
+          "the maps are copied; their old copies refuse writes until the proxy routes by the new daemon list:\n"
+          "  %s\nthen run this command again with --proxy-reloaded to delete the old copies\n",
+          RenderHint(new_daemons).c_str());
+      throw CLI::RuntimeError(kExitFailure);
+    }
+    if (!args_.proxy.empty()) AwaitProxy(moves);
+    Drop(moves);
+    std::printf("moved %zu maps\n", moves.size());
+  }
+
+ private:
+  [[noreturn]] void Fail(const std::string& message) const {
+    std::fprintf(stderr, "fremenctl %s: %s\n", command_.c_str(), message.c_str());
+    throw CLI::RuntimeError(kExitFailure);
+  }
+
+  void Copy(std::vector<Move>& moves) {
+    std::vector<const Move*> done;
+    for (Move& m : moves) {
+      if (m.committed) continue;
+      const Client& from = fleet_.Of(m.from);
+      const Client& to = fleet_.Of(m.to);
+      absl::Status status;
+      if (auto stopped = from.SetMapMove(m.map, v1::MAP_MOVE_STEP_STOP_WRITES, "", GlobalCall()); !stopped.ok()) {
+        status = stopped.status();
+      } else if (stopped->state() == v1::MAP_MOVE_STATE_MOVED) {
+        m.committed = true;  // committed by a run that this one's listing raced with
+        continue;
+      }
+      if (status.ok() && m.stale_target) {
+        // Left by a run that did not commit: the source has been the map's owner since.
+        status = to.DeleteMap(m.map, GlobalCall());
+        if (absl::IsNotFound(status)) status = absl::OkStatus();
+      }
+      const absl::Time start = absl::Now();
+      if (status.ok()) {
+        auto copied = from.CopyMapTo(to, m.map, "", TransferCall());
+        status = copied.status();
+        if (copied.ok()) {
+          std::printf("copied %s to %s (%llu bytes in %.2f s)\n", m.map.c_str(), m.to.c_str(),
+                      static_cast<unsigned long long>(copied->bytes()), absl::ToDoubleSeconds(absl::Now() - start));
+          std::fflush(stdout);
+        }
+      }
+      if (!status.ok()) {
+        ReportCall(command_, m.from, absl::StrCat("copying map ", m.map, " to ", m.to), status, m.map);
+        GiveUp(done, m);
+      }
+      done.push_back(&m);
+    }
+  }
+
+  // Undoes the copies not yet committed, so that the sources own their maps again.
+  void GiveUp(const std::vector<const Move*>& done, const Move& failed) {
+    for (const Move* m : done) (void)fleet_.Of(m->to).DeleteMap(m->map, GlobalCall());
+    for (const Move* m : done) (void)fleet_.Of(m->from).SetMapMove(m->map, v1::MAP_MOVE_STEP_RESUME_WRITES, "", GlobalCall());
+    (void)fleet_.Of(failed.from).SetMapMove(failed.map, v1::MAP_MOVE_STEP_RESUME_WRITES, "", GlobalCall());
+    Fail("nothing was moved (the copies made are deleted, the maps take writes where they were); run this again "
+         "once the cause is fixed");
+  }
+
+  void Commit(std::vector<Move>& moves) {
+    for (Move& m : moves) {
+      if (m.committed) continue;
+      auto moved = fleet_.Of(m.from).SetMapMove(m.map, v1::MAP_MOVE_STEP_MOVED, m.to, GlobalCall());
+      if (!moved.ok()) {
+        ReportCall(command_, m.from, absl::StrCat("committing the move of map ", m.map), moved.status(), m.map);
+        Fail("some maps are committed to their new owners and refuse writes where they were: run this again");
+      }
+      m.committed = true;
+    }
+  }
+
+  // Each moved map asked for through the proxy until its new owner answers: the target's copy
+  // serves, the old one is MOVED.
+  void AwaitProxy(const std::vector<Move>& moves) const {
+    const Fleet proxy(command_, {args_.proxy});
+    const Client& client = proxy.Of(args_.proxy);
+    const absl::Time give_up = absl::Now() + absl::Seconds(60);
+    for (const Move& m : moves) {
+      for (;;) {
+        auto got = client.GetMap(m.map, GlobalCall());
+        if (got.ok() && got->move_state() == v1::MAP_MOVE_STATE_SERVING) break;
+        if (absl::Now() > give_up) {
+          Fail(absl::StrCat("the proxy at ", args_.proxy, " still routes map ", m.map, " to ", m.from,
+                            " after 60 s; the old copies are kept: check the proxy, then run this again"));
+        }
+        absl::SleepFor(absl::Milliseconds(100));
+      }
+    }
+  }
+
+  void Drop(const std::vector<Move>& moves) const {
+    for (const Move& m : moves) {
+      const absl::Status deleted = fleet_.Of(m.from).DeleteMap(m.map, GlobalCall());
+      if (!deleted.ok() && !absl::IsNotFound(deleted)) {
+        ReportCall(command_, m.from, absl::StrCat("deleting the old copy of map ", m.map), deleted, m.map);
+        Fail("run this again to delete the old copies left");
+      }
+    }
+  }
+
+  const std::string command_;
+  const MoveArgs& args_;
+  const Fleet& fleet_;
+};
+
+// What to do with `map`, held by `source` (not its owner `owner`), given the owner's copy if any.
+// nullopt: nothing to move (reported).
+std::optional<Move> PlanOne(const std::string& command, const std::string& map, const std::string& source,
+                            const v1::Map& source_copy, const std::string& owner,
+                            const std::optional<v1::Map>& owner_copy) {
+  Move m{map, source, owner};
+  m.committed = source_copy.move_state() == v1::MAP_MOVE_STATE_MOVED;
+  if (m.committed && !owner_copy) {
+    std::fprintf(stderr, "fremenctl %s: map %s on %s says it moved to %s, but %s does not hold it; left as it is\n",
+                 command.c_str(), map.c_str(), source.c_str(), source_copy.moved_to().c_str(), owner.c_str());
+    return std::nullopt;
+  }
+  m.stale_target = !m.committed && owner_copy.has_value();
+  return m;
+}
+
+void RunRebalance(const MoveArgs& a) {
+  const std::string command = "fleet rebalance";
+  auto placement = Placement::Parse(a.daemons);
+  if (!placement.ok()) FailUsage(command, absl::StrCat("--daemons: ", placement.status().message()));
+  // The daemons asked: the new list, and any other --address names (daemons being removed).
+  std::vector<std::string> asked = placement->daemons();
+  if (NamesAFleet()) {
+    for (const std::string& address : Addresses()) {
+      if (absl::StartsWith(address, kEveryAddressPrefix)) {
+        FailUsage(command, absl::StrCat("name the daemons one by one, not ", address));
+      }
+      if (std::find(asked.begin(), asked.end(), address) == asked.end()) asked.push_back(address);
+    }
+  }
+  const Fleet fleet(command, asked);
+  const FleetMaps held = ListEachDaemon(command, fleet.daemons());
+  if (held.unreachable > 0) {
+    FailCall(command, "planning", absl::UnavailableError("every daemon must answer before maps are moved"));
+  }
+  // Every copy of every map, by map.
+  std::map<std::string, std::map<std::string, v1::Map>> copies;
+  for (const DaemonMaps& daemon : held.daemons) {
+    for (const v1::Map& map : daemon.maps) copies[map.name()][daemon.address] = map;
+  }
+  std::vector<Move> moves;
+  bool ambiguous = false;
+  for (const auto& [name, on] : copies) {
+    const std::string& owner = placement->Owner(name);
+    std::optional<v1::Map> owner_copy;
+    if (auto it = on.find(owner); it != on.end()) owner_copy = it->second;
+    std::vector<std::string> others;
+    for (const auto& [address, copy] : on) {
+      if (address != owner) others.push_back(address);
+    }
+    if (others.empty()) {
+      // On its owner. Writes left stopped by a run that died before it committed are resumed.
+      if (owner_copy->move_state() == v1::MAP_MOVE_STATE_WRITES_STOPPED) {
+        (void)fleet.Of(owner).SetMapMove(name, v1::MAP_MOVE_STEP_RESUME_WRITES, "", GlobalCall());
+      }
+      continue;
+    }
+    if (others.size() > 1) {
+      std::fprintf(stderr, "fremenctl %s: map %s is held by %s: move it by hand (fleet move)\n", command.c_str(),
+                   name.c_str(), absl::StrJoin(others, ", ").c_str());
+      ambiguous = true;
+      continue;
+    }
+    auto m = PlanOne(command, name, others[0], on.at(others[0]), owner, owner_copy);
+    if (m) {
+      moves.push_back(*m);
+    } else {
+      ambiguous = true;
+    }
+  }
+  Mover(command, a, fleet).Run(std::move(moves), placement->daemons());
+  if (ambiguous) throw CLI::RuntimeError(kExitFailure);
+}
+
+void RunMove(const MoveArgs& a) {
+  const std::string command = "fleet move";
+  if (a.from == a.to) FailUsage(command, "--from and --to name the same daemon");
+  const Fleet fleet(command, {a.from, a.to});
+  auto source = CopyOn(fleet.Of(a.from), a.map);
+  if (!source.ok()) FailCall(command, absl::StrCat("map ", a.map, " on ", a.from), source.status(), a.map);
+  auto target = CopyOn(fleet.Of(a.to), a.map);
+  if (!target.ok()) FailCall(command, absl::StrCat("map ", a.map, " on ", a.to), target.status(), a.map);
+  if (!*source) {
+    if (*target) {
+      std::printf("map %s is on %s already\n", a.map.c_str(), a.to.c_str());
+      return;
+    }
+    FailCall(command, absl::StrCat("map ", a.map), absl::NotFoundError(absl::StrCat("neither daemon holds it")), a.map);
+  }
+  auto m = PlanOne(command, a.map, a.from, **source, a.to, *target);
+  if (!m) throw CLI::RuntimeError(kExitFailure);
+  Mover(command, a, fleet).Run({*m}, {a.to});
+}
+
+void AddProxyOptions(CLI::App& app, MoveArgs& a) {
+  app.add_option("--proxy-command", a.proxy_command,
+                 "run (by /bin/sh) once the maps are copied and committed, before the old copies are deleted: it "
+                 "must make the proxy route by the new daemon list (render deploy/nginx, nginx -s reload)");
+  app.add_option("--proxy", a.proxy,
+                 "the proxy's gRPC address: after --proxy-command, wait until it routes each moved map to its new "
+                 "owner");
+  app.add_flag("--proxy-reloaded", a.proxy_reloaded,
+               "the proxy routes by the new daemon list already: delete the old copies (a run without "
+               "--proxy-command stops before that)");
+  app.add_flag("--dry-run", a.dry_run, "only list the moves");
+}
+
+}  // namespace
+
+void RegisterFleetMoveCommands(CLI::App& fleet) {
+  auto r = std::make_shared<MoveArgs>();
+  CLI::App* rebalance = fleet.add_subcommand(
+      "rebalance", "Move every map whose owner under the new daemon list is not the daemon that holds it");
+  rebalance->add_option("--daemons", r->daemons,
+                        "the fleet after the change, HOST:PORT,...: exactly the proxy's new `server` strings; every "
+                        "one is asked for its maps (add daemons being removed with --address)")
+      ->required();
+  AddProxyOptions(*rebalance, *r);
+  rebalance->footer(
+      "Writers of a moving map get UNAVAILABLE (\"map M is moving to another daemon; retry\") from when its copy "
+      "starts\nuntil the proxy routes to its new owner; queries go on. Run again after any failure "
+      "(docs/fleet.md).");
+  rebalance->callback([r] { RunRebalance(*r); });
+
+  auto m = std::make_shared<MoveArgs>();
+  CLI::App* move = fleet.add_subcommand("move", "Move one map from one daemon to another");
+  move->add_option("--map", m->map, "the map")->required();
+  move->add_option("--from", m->from, "the daemon that holds it, HOST:PORT")->required();
+  move->add_option("--to", m->to, "the daemon to hold it, HOST:PORT")->required();
+  AddProxyOptions(*move, *m);
+  move->callback([m] { RunMove(*m); });
+}
+
+}  // namespace fremen::client
