@@ -17,6 +17,7 @@
 #include "client/fremenctl/exit_codes.h"
 #include "client/fremenctl/fleet_maps.h"
 #include "client/fremenctl/transfer_commands.h"
+#include "client/lib/fleet_addresses.h"
 #include "client/lib/placement.h"
 
 namespace fremen::client {
@@ -236,15 +237,13 @@ void RunRebalance(const MoveArgs& a) {
     }
   }
   const Fleet fleet(command, asked);
-  const FleetMaps held = ListEachDaemon(command, fleet.daemons());
-  if (held.unreachable > 0) {
+  const FleetMaps held = ListFleetOrReport(command, ConnectFleetOrExit(command, asked));
+  if (!held.Unreachable().empty()) {
     FailCall(command, "planning", absl::UnavailableError("every daemon must answer before maps are moved"));
   }
   // Every copy of every map, by map.
   std::map<std::string, std::map<std::string, v1::Map>> copies;
-  for (const DaemonMaps& daemon : held.daemons) {
-    for (const v1::Map& map : daemon.maps) copies[map.name()][daemon.address] = map;
-  }
+  for (const FleetMap& copy : held.maps) copies[copy.map.name()][copy.daemon] = copy.map;
   std::vector<Move> moves;
   bool ambiguous = false;
   for (const auto& [name, on] : copies) {
