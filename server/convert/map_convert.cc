@@ -147,4 +147,12 @@ v1::MapMoveState MoveStateToProto(storage::MoveState state) {
   return v1::MAP_MOVE_STATE_UNSPECIFIED;
 }
 
+void AddMoveState(const storage::Store& store, v1::Map& map) {
+  auto open = store.Map(map.name());
+  if (!open.ok()) return;
+  const storage::MoveStatus move = (*open)->Move();
+  map.set_move_state(MoveStateToProto(move.state));
+  map.set_moved_to(move.moved_to);
+}
+
 }  // namespace fremen::server

@@ -9,6 +9,7 @@
 #include "fremen/v1/maps.pb.h"
 #include "storage/map_info.h"
 #include "storage/map_store.h"
+#include "storage/store.h"
 
 namespace fremen::server {
 
@@ -20,6 +21,9 @@ void MapInfoToProto(const storage::MapInfo& info, v1::Map& out);
 
 // A map's move state (docs/fleet.md, "Moving a map").
 v1::MapMoveState MoveStateToProto(storage::MoveState state);
+// Sets `map`'s output-only move_state and moved_to from its open store in `store` (a failed map has
+// none to tell: left unset).
+void AddMoveState(const storage::Store& store, v1::Map& map);
 
 // A storage validation error with storage's field names replaced by the proto's.
 absl::Status RenameStorageFields(const absl::Status& status);

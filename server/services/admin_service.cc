@@ -103,6 +103,7 @@ void VerifyReportToProto(const storage::VerifyReport& report, v1::CheckMapRespon
 
 void SalvageReportToProto(const storage::SalvageReport& report, v1::SalvageMapResponse& response) {
   MapInfoToProto(report.map, *response.mutable_map());
+  response.mutable_map()->set_move_state(v1::MAP_MOVE_STATE_SERVING);  // a new map
   response.set_records_kept(report.records_kept());
   response.set_records_lost(report.records_lost());
   for (const storage::SalvageShard& s : report.shards) {
@@ -295,6 +296,7 @@ absl::Status AdminServiceImpl::Restore(const v1::RestoreMapRequest& request, con
   }
   if (!info.ok()) return RenameNameField(info.status(), "map");
   MapInfoToProto(*info, *response.mutable_map());
+  AddMoveState(**store, *response.mutable_map());
   DaemonLog()->info("map {} restored from {}", info->name, *dir);
   return absl::OkStatus();
 }
@@ -421,6 +423,7 @@ absl::Status AdminServiceImpl::Import(StreamReader<v1::MapChunk>& in, const grpc
     return RenameNameField(info.status(), "header.map");
   }
   MapInfoToProto(*info, *response.mutable_map());
+  AddMoveState(**store, *response.mutable_map());
   response.set_bytes(writer.bytes());
   const absl::Duration took = admin_.clock->Now() - start;
   response.set_duration_seconds(absl::ToDoubleSeconds(took));

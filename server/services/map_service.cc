@@ -15,15 +15,6 @@ constexpr MethodSpec kGetMap{"GetMap", Access::kRead, /*blocking=*/false};
 constexpr MethodSpec kListMaps{"ListMaps", Access::kRead, /*blocking=*/false};
 constexpr MethodSpec kDeleteMap{"DeleteMap", Access::kWrite, /*blocking=*/true};
 
-// The map's move state (output only), from its open store; a failed map has none to tell.
-void AddMoveState(const storage::Store& store, v1::Map& map) {
-  auto open = store.Map(map.name());
-  if (!open.ok()) return;
-  const storage::MoveStatus move = (*open)->Move();
-  map.set_move_state(MoveStateToProto(move.state));
-  map.set_moved_to(move.moved_to);
-}
-
 }  // namespace
 
 grpc::ServerUnaryReactor* MapServiceImpl::CreateMap(grpc::CallbackServerContext* context,
