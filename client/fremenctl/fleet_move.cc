@@ -44,17 +44,17 @@ struct Move {
 class Fleet {
  public:
   Fleet(const std::string& command, const std::vector<std::string>& addresses)
-      : daemons_(ConnectEachOrExit(command, addresses)) {}
+      : client_(ConnectFleetOrExit(command, addresses)) {}
   const Client& Of(const std::string& address) const {
-    for (const Daemon& d : daemons_) {
+    for (const FleetMember& d : client_.members()) {
       if (d.address == address) return d.client;
     }
     std::abort();  // every address was connected
   }
-  const std::vector<Daemon>& daemons() const { return daemons_; }
+  const FleetClient& client() const { return client_; }
 
  private:
-  std::vector<Daemon> daemons_;
+  FleetClient client_;
 };
 
 // The map's copy on one daemon, or nullopt when it holds none (or does not answer: an error).
@@ -237,7 +237,7 @@ void RunRebalance(const MoveArgs& a) {
     }
   }
   const Fleet fleet(command, asked);
-  const FleetMaps held = ListFleetOrReport(command, ConnectFleetOrExit(command, asked));
+  const FleetMaps held = ListFleetOrReport(command, fleet.client());
   if (!held.Unreachable().empty()) {
     FailCall(command, "planning", absl::UnavailableError("every daemon must answer before maps are moved"));
   }
