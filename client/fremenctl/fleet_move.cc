@@ -30,6 +30,10 @@ struct MoveArgs {
   std::string proxy_command;
   std::string proxy;
   bool proxy_reloaded = false;
+  // After the proxy routes to the new owners, how long the old copies stay: a proxy's connections
+  // opened before its reload keep the old configuration until it closes them (nginx's old workers
+  // send GOAWAY and finish their streams), and a call on one still reaches the old copy.
+  double drain_seconds = 5;
   bool dry_run = false;
 };
 
@@ -105,6 +109,7 @@ class Mover {
       throw CLI::RuntimeError(kExitFailure);
     }
     if (!args_.proxy.empty()) AwaitProxy(moves);
+    absl::SleepFor(absl::Seconds(args_.drain_seconds));
     Drop(moves);
     std::printf("moved %zu maps\n", moves.size());
   }
@@ -308,6 +313,11 @@ void AddProxyOptions(CLI::App& app, MoveArgs& a) {
   app.add_flag("--proxy-reloaded", a.proxy_reloaded,
                "the proxy routes by the new daemon list already: delete the old copies (a run without "
                "--proxy-command stops before that)");
+  app.add_option("--drain-seconds", a.drain_seconds,
+                 "how long the old copies stay once the proxy routes to the new owners, for the proxy's connections "
+                 "opened before its reload (they keep the old configuration until the proxy closes them)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_flag("--dry-run", a.dry_run, "only list the moves");
 }
 
