@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "absl/strings/str_cat.h"
+#include "storage/model/kernels/cpu_dispatch.h"
 #include "storage/model/model_settings.h"
 
 namespace fremen::model {
@@ -50,6 +51,8 @@ BinModel BinModel::FromSpectrum(const SlotSpectrum& spectrum, uint64_t span, int
   for (size_t k = 1; k <= n / 2; ++k) {
     // Period n/k slots must not exceed 2/3 of the span: 3n ≤ 2k·span (exact in integers).
     if (3 * n > 2 * k * span) continue;
+    // All powers 0: no later bin is strictly stronger, so the first `capacity` eligible bins stay.
+    if (best.size() == capacity && spectrum.all_zero()) break;
     const double power = spectrum.power(k);
     if (best.size() == capacity && !(power > best.back().power)) continue;
     auto at = std::upper_bound(best.begin(), best.end(), power,
@@ -166,7 +169,8 @@ SlotPredictor::SlotPredictor(const BinModel& model) : model_(model) {
   for (uint64_t q = 0; q < coarse_.size(); ++q) coarse_[q] = BinPhasor(q << fine_bits_, n);
 }
 
-void SlotPredictor::AddComponent(size_t j, uint64_t begin, std::span<double> out) const {
+// Cloned for FMA (cpu_dispatch.h): every slot of every update and reconstruction passes here.
+FREMEN_FMA_CLONES void SlotPredictor::AddComponent(size_t j, uint64_t begin, std::span<double> out) const {
   const BinComponent& c = model_.components()[j];
   const uint64_t n = model_.length();
   const uint64_t k = c.k;

@@ -80,6 +80,32 @@ TEST(LosslessSlotSpectrum, EqualsADirectDftOverTheObservedSlots) {
   }
 }
 
+// A constant signal skips the transform (bin_spectrum.cc): its spectrum must still be the zeros a
+// transform gives, all +0.0, with the mean and counts of the transformed path.
+TEST(LosslessSlotSpectrum, ConstantSignalsWithGapsHaveAnAllZeroSpectrum) {
+  for (size_t n : {1u, 2u, 7u, 60u, 97u, 256u}) {
+    for (const SlotState value : {SlotState::kFree, SlotState::kOccupied}) {
+      std::vector<SlotState> signal = RandomSignal(n, 0.5, 0.3, n);
+      uint64_t observed = 0;
+      for (SlotState& s : signal) {
+        if (s != SlotState::kUnobserved) s = value, ++observed;
+      }
+      const SlotSpectrum spectrum = SlotSpectrum::Compute(signal);
+      ASSERT_EQ(spectrum.observed(), observed) << "n " << n;
+      EXPECT_EQ(spectrum.gamma0(), observed > 0 && value == SlotState::kOccupied ? 1.0 : 0.0) << "n " << n;
+      for (size_t k = 1; k <= n / 2; ++k) {
+        EXPECT_EQ(spectrum.power(k), 0.0) << "n " << n << " k " << k;
+        EXPECT_FALSE(std::signbit(spectrum.gamma(k).real()) || std::signbit(spectrum.gamma(k).imag()))
+            << "n " << n << " k " << k;
+      }
+      // Its model: the mean, and zero-amplitude components of phase 0 that change no prediction.
+      const BinModel model = BinModel::FromSpectrum(spectrum, n - 1, 3);
+      for (const BinComponent& c : model.components()) EXPECT_EQ(c.phase(), 0.0) << "n " << n;
+      for (size_t i = 0; i < n; ++i) EXPECT_EQ(model.SlotValue(i), model.alpha0()) << "n " << n;
+    }
+  }
+}
+
 TEST(LosslessSlotSpectrum, FindsAPureToneAtItsBin) {
   const size_t n = 1200;
   std::vector<SlotState> signal(n);

@@ -86,7 +86,16 @@ SlotSpectrum SlotSpectrum::Compute(std::span<const SlotState> signal) {
         data[i] = 0.0;
     }
   }
+  // A signal constant wherever it was observed (most cells of a building: walls, floor) is all zeros
+  // once its mean is removed, and so is its transform: the FFT, most of such a cell's update, is
+  // skipped. Every bin is +0.0 (FFTW's own zeros would carry arbitrary signs), so the model's
+  // zero-amplitude components have phase 0.
   if (n == 0) return spectrum;
+  if (ones == 0 || ones == spectrum.observed_) {
+    std::fill(data, data + 2 * (n / 2 + 1), 0.0);
+    spectrum.all_zero_ = true;
+    return spectrum;
+  }
   const Plan plan = InPlaceR2cPlan(static_cast<int>(n), data);
   fftw_execute_dft_r2c(plan.get(), data, reinterpret_cast<fftw_complex*>(data));
   return spectrum;

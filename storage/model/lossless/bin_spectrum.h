@@ -34,6 +34,8 @@ class SlotSpectrum {
   // Bins held: 0..n/2.
   size_t bins() const { return length_ / 2 + 1; }
   uint64_t observed() const { return observed_; }
+  // True when every bin is zero: the signal was constant wherever it was observed (no transform ran).
+  bool all_zero() const { return all_zero_; }
   // γ0 (0 when nothing was observed).
   double gamma0() const { return gamma0_; }
   // γ_k for k in [1, n/2] (γ_0 of the mean-removed signal is 0: use gamma0()).
@@ -49,6 +51,7 @@ class SlotSpectrum {
   size_t length_ = 0;
   uint64_t observed_ = 0;
   double gamma0_ = 0;
+  bool all_zero_ = false;
   // In-place r2c layout: bin k is (data[2k], data[2k+1]).
   std::unique_ptr<double[], FftwFree> data_;
 };

@@ -26,6 +26,9 @@ class ValueSource {
   void Values(uint64_t begin, std::span<double> out) const {
     if (predictor_) {
       predictor_->Values(begin, model_.order(), out);
+    } else if (model_.order() == 0) {
+      // What SlotValue gives at order 0, without a call per slot: most cells of a building.
+      std::fill(out.begin(), out.end(), static_cast<double>(model_.alpha0()));
     } else {
       for (size_t i = 0; i < out.size(); ++i) out[i] = model_.SlotValue(begin + i);
     }
