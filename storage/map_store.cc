@@ -672,15 +672,42 @@ absl::Status MapStoreImpl::WriteCheckpoint(uint64_t lsn, std::vector<Shard::Chec
   return status;
 }
 
-std::vector<float> MapStoreImpl::Predict(std::span<const uint64_t> keys, std::span<const double> times,
-                                     const PredictOptions& options) const {
-  std::vector<float> out;
-  out.reserve(keys.size() * times.size());
-  for (double t : times) {
-    const model::PhasorTable table(settings_->periods, t);
-    for (uint64_t key : keys) out.push_back(ShardFor(key).Predict(key, table, options));
+std::vector<std::vector<uint32_t>> MapStoreImpl::PositionsByShard(std::span<const uint64_t> keys) const {
+  std::vector<std::vector<uint32_t>> at(shards_.size());
+  for (auto& positions : at) positions.reserve(keys.size() / shards_.size() + 1);
+  for (size_t i = 0; i < keys.size(); ++i) at[ShardOf(keys[i], info_.shards)].push_back(static_cast<uint32_t>(i));
+  return at;
+}
+
+std::vector<float> MapStoreImpl::PredictKeys(std::span<const uint64_t> keys, std::span<const double> times,
+                                             const PredictOptions& options, uint8_t* observed) const {
+  std::vector<float> out(keys.size() * times.size());
+  const std::vector<std::vector<uint32_t>> at = PositionsByShard(keys);
+  for (size_t j = 0; j < times.size(); ++j) {
+    const model::PhasorTable table(settings_->periods, times[j]);
+    float* row = out.data() + j * keys.size();
+    uint8_t* observed_now = j == 0 ? observed : nullptr;
+    ParallelForShards(
+        shards_.size(), [&](size_t s) { shards_[s]->PredictKeys(keys, at[s], table, options, row, observed_now); },
+        /*parallel=*/keys.size() >= kParallelPredictions);
   }
   return out;
+}
+
+std::vector<float> MapStoreImpl::Predict(std::span<const uint64_t> keys, std::span<const double> times,
+                                         const PredictOptions& options) const {
+  return PredictKeys(keys, times, options, nullptr);
+}
+
+std::vector<float> MapStoreImpl::PredictWithObserved(std::span<const uint64_t> keys, std::span<const double> times,
+                                                     const PredictOptions& options,
+                                                     std::vector<uint8_t>& observed) const {
+  if (times.empty()) {  // no time to predict at, but the caller still asks which keys were observed
+    observed = Observed(keys);
+    return {};
+  }
+  observed.assign(keys.size(), 0);
+  return PredictKeys(keys, times, options, observed.data());
 }
 
 absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
@@ -707,7 +734,8 @@ std::optional<StateSnapshot> MapStoreImpl::Snapshot(uint64_t key) const { return
 
 std::vector<uint8_t> MapStoreImpl::Observed(std::span<const uint64_t> keys) const {
   std::vector<uint8_t> out(keys.size());
-  for (size_t i = 0; i < keys.size(); ++i) out[i] = ShardFor(keys[i]).Observed(keys[i]);
+  const std::vector<std::vector<uint32_t>> at = PositionsByShard(keys);
+  for (size_t s = 0; s < shards_.size(); ++s) shards_[s]->ObservedKeys(keys, at[s], out.data());
   return out;
 }
 

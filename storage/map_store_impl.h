@@ -55,6 +55,8 @@ class MapStoreImpl final : public MapStore {
                           std::vector<float>& out) const override;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const override;
   std::vector<uint8_t> Observed(std::span<const uint64_t> keys) const override;
+  std::vector<float> PredictWithObserved(std::span<const uint64_t> keys, std::span<const double> times,
+                                         const PredictOptions& options, std::vector<uint8_t>& observed) const override;
   std::optional<std::pair<std::string, std::string>> Label(uint64_t key) const override {
     return ShardFor(key).Label(key);
   }
@@ -140,6 +142,14 @@ class MapStoreImpl final : public MapStore {
     return queued_observations_ == 0 || queued_observations_ + n <= options_.max_queued_observations;
   }
   const Shard& ShardFor(uint64_t key) const { return *shards_[ShardOf(key, info_.shards)]; }
+  // at[s]: the positions in `keys` of shard s's keys, in order.
+  std::vector<std::vector<uint32_t>> PositionsByShard(std::span<const uint64_t> keys) const;
+  // Predict's work; fills observed (keys.size() bytes) at the first time when it is not null.
+  std::vector<float> PredictKeys(std::span<const uint64_t> keys, std::span<const double> times,
+                                 const PredictOptions& options, uint8_t* observed) const;
+  // From this many keys a time, Predict asks the shards at once, each on its own thread (as
+  // PredictBox does from 2^16 cells): below it a thread's start costs more than it saves.
+  static constexpr size_t kParallelPredictions = size_t{1} << 16;
 
   const MapInfo info_;
   const std::string dir_;

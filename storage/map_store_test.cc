@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <random>
 #include <thread>
 
 #include "storage/env/fault_injection_env.h"
@@ -190,6 +192,48 @@ TEST(MapStoreTest, PredictionsOfPublishedStatesAreTheRegionKernelsBitForBit) {
     for (size_t j = 0; j < keys.size(); ++j) {
       ASSERT_EQ(region[cells[j]], kernel[j]) << "cell " << cells[j] << " order " << order;
       ASSERT_EQ(points[j], kernel[j]) << "cell " << cells[j] << " order " << order;
+    }
+  }
+}
+
+// Predict asks each shard once for all its keys, batches their published models through the kernel
+// and, from kParallelPredictions keys, runs the shards on their own threads: the answer must be what
+// asking key by key gives, at each time, in the caller's order (shuffled, with repeats and keys never
+// observed), and PredictWithObserved's flags must be Observed's.
+TEST(MapStoreTest, BatchedPredictionsEqualOneKeyAtATimeInTheCallersOrder) {
+  TempDir dir;
+  const MapInfo map = GridMap("m", 300, 300, 1, 3);
+  auto store = OpenOrDie(map, dir.path());
+  for (uint64_t i = 0; i < 200; ++i) ASSERT_TRUE(store->Write(SweepScan(map, 1, i, 2000)).ok());
+  ASSERT_TRUE(store->PublishModels().ok());
+  for (uint64_t i = 200; i < 230; ++i) ASSERT_TRUE(store->Write(SweepScan(map, 1, i, 2000)).ok());  // unpublished news
+
+  std::vector<uint64_t> keys;
+  for (uint32_t y = 0; y < 300; ++y) {
+    for (uint32_t x = 0; x < 300; ++x) keys.push_back(map.grid.keys().Key(x, y, 0));
+  }
+  for (size_t i = 0; i < 5000; ++i) keys.push_back(keys[(i * 7919) % keys.size()]);  // repeats
+  std::shuffle(keys.begin(), keys.end(), std::mt19937_64(7));
+  ASSERT_GE(keys.size(), 1u << 16);  // the parallel path
+  const std::vector<double> times = {1.7e9 + 3600, 1.7e9 + 200 * 600.0 + 5000, 1.7e9 + 86400 * 3};
+  const std::vector<uint8_t> flags = store->Observed(keys);
+  size_t observed = 0;
+  for (uint8_t f : flags) observed += f;
+  ASSERT_GT(observed, 1000u);
+  ASSERT_LT(observed, keys.size());  // some never observed
+  for (const bool persistence : {false, true}) {
+    PredictOptions options;
+    options.persistence = persistence;
+    std::vector<uint8_t> observed_flags;
+    const std::vector<float> batched = store->PredictWithObserved(keys, times, options, observed_flags);
+    ASSERT_EQ(batched, store->Predict(keys, times, options));
+    ASSERT_EQ(observed_flags, flags);
+    ASSERT_EQ(batched.size(), keys.size() * times.size());
+    for (size_t j = 0; j < times.size(); ++j) {
+      for (size_t i = 0; i < keys.size(); i += 97) {
+        ASSERT_EQ(batched[j * keys.size() + i], store->Predict({&keys[i], 1}, {&times[j], 1}, options)[0])
+            << "key " << keys[i] << " time " << times[j] << " persistence " << persistence;
+      }
     }
   }
 }

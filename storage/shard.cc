@@ -275,6 +275,82 @@ float Shard::Predict(uint64_t key, const model::PhasorTable& table, const Predic
   return PredictHandle(brick_data_[it->second].handles[key & 511], table, options);
 }
 
+namespace {
+
+// The brick of consecutive keys is usually the same (a scan's cells, a region's rows): one hash
+// lookup per change of brick.
+class BrickLookup {
+ public:
+  template <typename Map>
+  int64_t operator()(const Map& bricks, uint64_t brick) {
+    if (brick != brick_) {
+      const auto it = bricks.find(brick);
+      brick_ = brick;
+      index_ = it == bricks.end() ? -1 : static_cast<int64_t>(it->second);
+    }
+    return index_;
+  }
+
+ private:
+  uint64_t brick_ = UINT64_MAX;
+  int64_t index_ = -1;
+};
+
+}  // namespace
+
+void Shard::PredictKeys(std::span<const uint64_t> keys, std::span<const uint32_t> at,
+                        const model::PhasorTable& table, const PredictOptions& options, float* out,
+                        uint8_t* observed) const {
+  base::ReaderMutexLock lock(&mutex_);
+  constexpr size_t kBatch = 512;
+  std::array<int64_t, kBatch> bricks;
+  std::array<uint32_t, kBatch> handles;
+  std::array<uint32_t, kBatch> published;
+  std::array<uint32_t, kBatch> published_at;
+  std::array<float, kBatch> predicted;
+  // kBatch positions at a time, in passes that each prefetch what the next one reads: a batch of
+  // scattered states (a dashboard's, a fleet's) misses the cache three times per state — the brick
+  // table, the brick's handles, the model record — and the passes overlap those misses instead of
+  // taking them one after another. Published models then go through the region kernel together.
+  for (size_t begin = 0; begin < at.size(); begin += kBatch) {
+    const size_t count = std::min(at.size() - begin, kBatch);
+    const uint32_t* positions = at.data() + begin;
+    for (size_t k = 0; k < count; ++k) bricks_.prefetch(BrickOf(keys[positions[k]]));
+    BrickLookup lookup;
+    for (size_t k = 0; k < count; ++k) {
+      const uint64_t key = keys[positions[k]];
+      bricks[k] = lookup(bricks_, BrickOf(key));
+      if (bricks[k] >= 0) __builtin_prefetch(&brick_data_[bricks[k]].handles[key & 511]);
+    }
+    for (size_t k = 0; k < count; ++k) {
+      handles[k] = bricks[k] < 0 ? kNone : brick_data_[bricks[k]].handles[keys[positions[k]] & 511];
+      if (handles[k] != kNone && !(handles[k] & kStaticHandle)) model::PrefetchForRead(models_.record(handles[k]), 64);
+    }
+    size_t n = 0;
+    for (size_t k = 0; k < count; ++k) {
+      const uint32_t i = positions[k], handle = handles[k];
+      if (observed) observed[i] = handle != kNone;
+      if (handle != kNone && !(handle & kStaticHandle) && models_.published(handle)) {
+        published[n] = handle;
+        published_at[n++] = i;
+      } else {
+        out[i] = PredictHandle(handle, table, options);
+      }
+    }
+    PredictPublished({published.data(), n}, table, options, predicted.data());
+    for (size_t j = 0; j < n; ++j) out[published_at[j]] = predicted[j];
+  }
+}
+
+void Shard::ObservedKeys(std::span<const uint64_t> keys, std::span<const uint32_t> at, uint8_t* out) const {
+  base::ReaderMutexLock lock(&mutex_);
+  BrickLookup lookup;
+  for (const uint32_t i : at) {
+    const int64_t brick = lookup(bricks_, BrickOf(keys[i]));
+    out[i] = brick >= 0 && brick_data_[brick].handles[keys[i] & 511] != kNone;
+  }
+}
+
 void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
                        float* out) const {
   if (box.cell_count() == 0) return;

@@ -131,6 +131,13 @@ class Shard {
   std::optional<StateSnapshot> Snapshot(uint64_t key) const;
   // Whether the state was ever observed (cheap: one brick lookup).
   bool Observed(uint64_t key) const;
+  // The batched forms, under one lock: for each i, out[at[i]] = Predict(keys[at[i]], ...) /
+  // Observed(keys[at[i]]). REQUIRES: every keys[at[i]] is this shard's. Published models go through
+  // the region kernel together, as in PredictBox.
+  // PredictKeys also sets observed[at[i]] when `observed` is not null (the same lookup).
+  void PredictKeys(std::span<const uint64_t> keys, std::span<const uint32_t> at, const model::PhasorTable& table,
+                   const PredictOptions& options, float* out, uint8_t* observed = nullptr) const;
+  void ObservedKeys(std::span<const uint64_t> keys, std::span<const uint32_t> at, uint8_t* out) const;
   // A generic state's name and group, when labelled.
   std::optional<std::pair<std::string, std::string>> Label(uint64_t key) const;
   ShardStats Stats() const;

@@ -62,7 +62,8 @@ absl::Status DoPredict(const StoreHandle& store, const grpc::ServerContextBase& 
   auto keys = KeysOfRefs(info, request.states(), "states");
   if (!keys.ok()) return keys.status();
 
-  const std::vector<float> p = (*map)->Predict(*keys, SpanOf(request.times()), *options);
+  std::vector<uint8_t> observed;
+  const std::vector<float> p = (*map)->PredictWithObserved(*keys, SpanOf(request.times()), *options, observed);
   if (!request.states_only()) response.mutable_probabilities()->Add(p.begin(), p.end());
   if (request.has_confidence()) {
     auto& states = *response.mutable_states();
@@ -71,7 +72,6 @@ absl::Status DoPredict(const StoreHandle& store, const grpc::ServerContextBase& 
   }
   response.set_state_count(static_cast<uint32_t>(keys->size()));
   response.set_time_count(static_cast<uint32_t>(request.times_size()));
-  const std::vector<uint8_t> observed = (*map)->Observed(*keys);
   for (size_t j = 0; j < observed.size(); ++j) {
     if (!observed[j]) response.add_unobserved(static_cast<uint32_t>(j));
   }

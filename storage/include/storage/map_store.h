@@ -196,6 +196,10 @@ class MapStore {
   virtual std::optional<StateSnapshot> Snapshot(uint64_t key) const = 0;
   // observed[i]: whether keys[i] was ever observed.
   virtual std::vector<uint8_t> Observed(std::span<const uint64_t> keys) const = 0;
+  // Predict and Observed together, in one lookup per key: `observed` is resized to keys.size().
+  virtual std::vector<float> PredictWithObserved(std::span<const uint64_t> keys, std::span<const double> times,
+                                                 const PredictOptions& options,
+                                                 std::vector<uint8_t>& observed) const = 0;
   virtual std::optional<std::pair<std::string, std::string>> Label(uint64_t key) const = 0;
   // Every labelled state (a batch named it or gave it a group), or only those of `group` when it
   // is not empty (NOT_FOUND when no state has that group); in (name, key) order. Linear in the
