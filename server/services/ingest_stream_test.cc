@@ -59,7 +59,9 @@ class IngestStreamTest : public ::testing::Test {
     }
     if (store_ != nullptr) {
       const absl::Status closed = store_->Close();
-      if (!disk_full_) EXPECT_TRUE(closed.ok()) << closed;
+      if (!disk_full_) {
+        EXPECT_TRUE(closed.ok()) << closed;
+      }
     }
   }
 
