@@ -18,16 +18,13 @@
 #include <string>
 #include <vector>
 
-#include "client/lib/client.h"
 #include "client/lib/scan_builder.h"
-#include "tests/fremend_fixture.h"
+#include "tests/client_daemon_test.h"
 #include "tests/map_specs.h"
 
 namespace fremen::testing {
 namespace {
 
-using ::fremen::client::Client;
-using ::fremen::client::ConnectionOptions;
 using ::fremen::client::ScanBuilder;
 using ::fremen::client::StateSet;
 using ::testing::HasSubstr;
@@ -124,16 +121,12 @@ int ExpectedOrder(const v1::Map& map, const std::vector<double>& r) {
   return pick;
 }
 
-class OrderSelectionTest : public DaemonTest {
+class OrderSelectionTest : public ClientDaemonTest {
  protected:
   void SetUp() override {
     DaemonTest::SetUp();
     if (HasFatalFailure()) return;
-    ConnectionOptions options;
-    options.address = daemon_->address();
-    auto client = Client::Connect(options);
-    ASSERT_TRUE(client.ok()) << client.status();
-    client_.emplace(*std::move(client));
+    ConnectClient();
   }
 
   v1::Map Create(const Rule& rule) {
@@ -149,18 +142,6 @@ class OrderSelectionTest : public DaemonTest {
     EXPECT_TRUE(created.ok()) << created.status();
     return created.ok() ? *created : v1::Map();
   }
-
-  void Update(const std::string& map) {
-    auto op = client_->RunUpdate(map);
-    ASSERT_TRUE(op.ok()) << op.status();
-    client::WaitOptions wait;
-    wait.poll_interval = absl::Milliseconds(20);
-    auto done = client_->WaitOperation(map, op->name(), wait);
-    ASSERT_TRUE(done.ok()) << done.status();
-    ASSERT_EQ(done->error().code(), 0) << done->error().message();
-  }
-
-  std::optional<Client> client_;
 };
 
 TEST_F(OrderSelectionTest, EachRuleIsHonouredAndTheDefaultIsNotWorseThanThePapersOnGeneratedData) {
@@ -207,7 +188,7 @@ TEST_F(OrderSelectionTest, EachRuleIsHonouredAndTheDefaultIsNotWorseThanThePaper
         ASSERT_TRUE((*session)->Send(*std::move(built)).ok());
       }
       ASSERT_TRUE((*session)->Close(absl::Seconds(60)).ok());
-      Update(map.name());
+      UpdateAndWait(map.name());
     }
   }
 

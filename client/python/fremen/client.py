@@ -196,7 +196,8 @@ class Client(AdminCalls):
                    max_order: Optional[int] = None, persistence: Optional[bool] = None,
                    error_half_life: Optional[float] = None, criterion: Optional[str] = None,
                    order_selection: Optional[str] = None, order_margin: Optional[float] = None,
-                   order_temperature: Optional[float] = None, lossless_sampling: float = 0.0, lossless_origin: float = 0.0, shards: int = 0) -> MapInfo:
+                   order_temperature: Optional[float] = None, lossless_sampling: float = 0.0,
+                   lossless_origin: float = 0.0, shards: int = 0) -> MapInfo:
         """Creates a map and returns its MapInfo (every default filled in; its fields are named as
         these parameters).
 
