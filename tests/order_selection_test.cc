@@ -226,10 +226,12 @@ TEST_F(OrderSelectionTest, EachRuleIsHonouredAndTheDefaultIsNotWorseThanThePaper
 
     auto predictions = client_->Predict(map.name(), StateSet::Ids(ids), times);
     ASSERT_TRUE(predictions.ok()) << predictions.status();
+    std::vector<double> kind_err(6);  // by the World's kinds, for the printed figures
     for (size_t k = 0; k < test.size(); ++k) {
       for (int i = 0; i < kStates; ++i) {
         const double p = predictions->probability(k, i), s = test[k].second[i];
         err[m] += std::fabs((p > 0.5 ? 1.0 : 0.0) - s);
+        kind_err[i % 6] += std::fabs((p > 0.5 ? 1.0 : 0.0) - s) / (test.size() * kStates / 6);
         mse[m] += (p - s) * (p - s);
       }
     }
@@ -237,8 +239,10 @@ TEST_F(OrderSelectionTest, EachRuleIsHonouredAndTheDefaultIsNotWorseThanThePaper
     mse[m] /= test.size() * kStates;
     std::string order_list;
     for (int o : orders) order_list += std::to_string(o) + " ";
-    std::printf("order selection %-8s test err %.4f mse %.4f orders %s\n", map.name().c_str(), err[m], mse[m],
-                order_list.c_str());
+    std::printf("order selection %-8s test err %.4f mse %.4f orders %s| err by kind (moved, weekly, rare, noise, "
+                "two-component, telegraph) %.4f %.4f %.4f %.4f %.4f %.4f\n",
+                map.name().c_str(), err[m], mse[m], order_list.c_str(), kind_err[0], kind_err[1], kind_err[2],
+                kind_err[3], kind_err[4], kind_err[5]);
   }
   EXPECT_LE(err[1], err[0] + kErrBound);
   EXPECT_LE(mse[1], mse[0] + kMseBound);
