@@ -23,6 +23,7 @@ std::string FirstDifference(const fremen::storage::MapInfo& a, const fremen::sto
   if (a.persistence != b.persistence) return "persistence";
   if (a.error_half_life != b.error_half_life) return "error_half_life";
   if (a.criterion != b.criterion) return "criterion";
+  if (a.order_rule != b.order_rule) return "order_rule";
   if (a.lossless_sampling_period != b.lossless_sampling_period) return "lossless_sampling_period";
   if (a.lossless_origin != b.lossless_origin) return "lossless_origin";
   if (a.shards != b.shards) return "shards";

@@ -125,6 +125,8 @@ void MapSeeds() {
   grid.set_persistence(false);
   grid.set_error_half_life_seconds(0);
   grid.set_criterion(v1::ERROR_CRITERION_SQUARED);
+  grid.set_order_selection(v1::ORDER_SELECTION_MARGIN);
+  grid.set_order_margin(0.002);
   grid.set_shards(4);
   Seed("map_convert", "grid_3d", grid.SerializeAsString());
   v1::Map generic;

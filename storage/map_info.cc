@@ -11,7 +11,9 @@ using model::ByteReader;
 
 namespace {
 
-constexpr uint8_t kMapInfoVersion = 1;
+// Version 2 appended the order rule; version 1 records are still read (order_rule = margin 0.001).
+constexpr uint8_t kMapInfoVersion = 2;
+constexpr uint8_t kMapInfoVersionWithoutOrderRule = 1;
 constexpr size_t kMaxNameLength = 128;
 constexpr uint32_t kMaxShards = 256;
 constexpr uint32_t kMaxGridSide = 1u << 21;
@@ -90,6 +92,17 @@ absl::Status ValidateMapInfo(const MapInfo& info) {
   if (info.criterion != model::ErrorCriterion::kThreshold && info.criterion != model::ErrorCriterion::kSquared) {
     return absl::InvalidArgumentError("criterion must be threshold or squared");
   }
+  const model::OrderRule& rule = info.order_rule;
+  if (rule.selection != model::OrderSelection::kMargin && rule.selection != model::OrderSelection::kPaper &&
+      rule.selection != model::OrderSelection::kWeighted) {
+    return absl::InvalidArgumentError("order_selection must be margin, paper or weighted");
+  }
+  if (!std::isfinite(rule.margin) || rule.margin < 0) {
+    return absl::InvalidArgumentError(absl::StrCat("order_margin must be finite and ≥ 0, got ", rule.margin));
+  }
+  if (!std::isfinite(rule.temperature) || rule.temperature <= 0) {
+    return absl::InvalidArgumentError(absl::StrCat("order_temperature must be finite and > 0, got ", rule.temperature));
+  }
   if (!std::isfinite(info.lossless_sampling_period) || info.lossless_sampling_period < 0) {
     return absl::InvalidArgumentError(absl::StrCat(
         "lossless_sampling_period must be ≥ 0 seconds (0: no lossless history), got ", info.lossless_sampling_period));
@@ -113,6 +126,7 @@ absl::StatusOr<model::ModelSettings> ModelSettingsOf(const MapInfo& info) {
   settings.persistence = info.persistence;
   settings.error_half_life = info.error_half_life;
   settings.criterion = info.criterion;
+  settings.order_rule = info.order_rule;
   return settings;
 }
 
@@ -120,6 +134,7 @@ absl::StatusOr<model::ModelSettings> ModelSettingsOf(const MapInfo& info) {
 // resolution f64 | origin 3×f64 | size 3×varint | longest f64 | count varint | floor u8 |
 // explicit periods (varint count, f64 each) | max_order varint | persistence u8 | half-life f64 |
 // criterion u8 | lossless period f64 | lossless origin f64 | shards varint | created zigzag varint.
+// Version 2 appends: order selection u8 | order margin f64 | order temperature f64.
 std::string EncodeMapInfo(const MapInfo& info) {
   std::string out;
   out.push_back(static_cast<char>(kMapInfoVersion));
@@ -143,13 +158,17 @@ std::string EncodeMapInfo(const MapInfo& info) {
   model::PutDouble(&out, info.lossless_origin);
   model::PutVarint64(&out, info.shards);
   model::PutVarint64(&out, model::ZigZagEncode64(info.created_unix));
+  out.push_back(static_cast<char>(info.order_rule.selection));
+  model::PutDouble(&out, info.order_rule.margin);
+  model::PutDouble(&out, info.order_rule.temperature);
   return out;
 }
 
 absl::StatusOr<MapInfo> DecodeMapInfo(std::string_view bytes) {
   ByteReader r(bytes, "map info");
   MapInfo info;
-  if (const uint8_t version = r.Byte("version"); r.ok() && version != kMapInfoVersion) {
+  const uint8_t version = r.Byte("version");
+  if (r.ok() && version != kMapInfoVersion && version != kMapInfoVersionWithoutOrderRule) {
     r.Fail("version", absl::StrCat("unknown version ", version));
   }
   const uint64_t name_length = r.Varint("name length");
@@ -182,6 +201,13 @@ absl::StatusOr<MapInfo> DecodeMapInfo(std::string_view bytes) {
   info.lossless_origin = r.Double("lossless_origin");
   info.shards = static_cast<uint32_t>(r.Varint("shards"));
   info.created_unix = model::ZigZagDecode64(r.Varint("created"));
+  if (version == kMapInfoVersionWithoutOrderRule) {
+    info.order_rule = model::OrderRule{model::OrderSelection::kMargin, model::kDefaultOrderMargin};
+  } else {
+    info.order_rule.selection = static_cast<model::OrderSelection>(r.Byte("order_selection"));
+    info.order_rule.margin = r.Double("order_margin");
+    info.order_rule.temperature = r.Double("order_temperature");
+  }
   if (absl::Status s = r.Finish(); !s.ok()) return s;
   if (absl::Status s = ValidateMapInfo(info); !s.ok()) {
     return absl::DataLossError(absl::StrCat("map info: stored record is invalid: ", s.message()));

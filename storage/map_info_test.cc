@@ -26,6 +26,39 @@ TEST(MapInfoTest, EncodingRoundTrips) {
   auto decoded = DecodeMapInfo(EncodeMapInfo(info));
   ASSERT_TRUE(decoded.ok()) << decoded.status();
   EXPECT_EQ(*decoded, info);
+  info.order_rule = model::OrderRule{model::OrderSelection::kMargin, 0.004, 0.5};
+  decoded = DecodeMapInfo(EncodeMapInfo(info));
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ(decoded->order_rule, info.order_rule);
+}
+
+TEST(MapInfoTest, NewMapsTakeTheWeightedRule) {
+  const MapInfo info;
+  EXPECT_EQ(info.order_rule.selection, model::OrderSelection::kWeighted);
+  EXPECT_EQ(info.criterion, model::ErrorCriterion::kSquared);
+  EXPECT_EQ(info.error_half_life, 3 * 86400.0);
+}
+
+// A version-1 record (before the order rule was stored) is the version-2 encoding without its last
+// 17 bytes: it reads back with the rule those maps were made with, margin 0.001.
+TEST(MapInfoTest, VersionOneRecordsKeepTheMarginRule) {
+  MapInfo info = Office();
+  info.criterion = model::ErrorCriterion::kThreshold;
+  info.error_half_life = 7 * 86400.0;
+  std::string bytes = EncodeMapInfo(info);
+  ASSERT_EQ(bytes[0], 2);
+  bytes[0] = 1;
+  bytes.resize(bytes.size() - 17);
+  auto decoded = DecodeMapInfo(bytes);
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ(decoded->order_rule, (model::OrderRule{model::OrderSelection::kMargin, 0.001}));
+  EXPECT_EQ(decoded->criterion, model::ErrorCriterion::kThreshold);
+  EXPECT_EQ(decoded->error_half_life, 7 * 86400.0);
+  auto settings = ModelSettingsOf(*decoded);
+  ASSERT_TRUE(settings.ok());
+  EXPECT_EQ(settings->order_rule.selection, model::OrderSelection::kMargin);
+  bytes[0] = 3;
+  EXPECT_TRUE(absl::IsDataLoss(DecodeMapInfo(bytes).status()));
 }
 
 TEST(MapInfoTest, ValidationNamesTheField) {
@@ -52,6 +85,15 @@ TEST(MapInfoTest, ValidationNamesTheField) {
   bad = Office();
   bad.error_half_life = NAN;
   EXPECT_NE(message_of(bad).find("error_half_life"), std::string::npos);
+  bad = Office();
+  bad.order_rule.selection = static_cast<model::OrderSelection>(7);
+  EXPECT_NE(message_of(bad).find("order_selection"), std::string::npos);
+  bad = Office();
+  bad.order_rule.margin = -0.1;
+  EXPECT_NE(message_of(bad).find("order_margin"), std::string::npos);
+  bad = Office();
+  bad.order_rule.temperature = 0;
+  EXPECT_NE(message_of(bad).find("order_temperature"), std::string::npos);
   EXPECT_TRUE(ValidateMapInfo(Office()).ok());
 }
 

@@ -22,7 +22,7 @@ constexpr size_t kStatesPerLock = 1024;
 
 void Shard::PublishState(uint32_t d, bool history_updated) {
   spectra_.Load(d, publish_scratch_);
-  publisher_.Publish(publish_scratch_, errors_.BestOrder(d), models_, d);
+  publisher_.Publish(publish_scratch_, errors_.BestOrder(d, settings_.order_rule), models_, d);
   if (settings_.error_half_life == 0) errors_.Reset(d);  // "only since the last update"
   if (lossless_ && !history_updated) (void)lossless_histories_[d].Update(settings_.max_order);
   publish_flags_[d] = 0;

@@ -12,6 +12,7 @@
 
 #include "absl/time/clock.h"
 #include "client/lib/client.h"
+#include "tests/client_daemon_test.h"
 #include "tests/fremend_fixture.h"
 #include "tests/map_specs.h"
 
@@ -51,16 +52,12 @@ float DayPattern(double t) {
   return hour >= 8 && hour < 18 ? 1.0f : 0.0f;
 }
 
-class ClientLibraryTest : public DaemonTest {
+class ClientLibraryTest : public ClientDaemonTest {
  protected:
   void SetUp() override {
     StartDaemon({"--backup-dir", dir_.Path("backups")});
     if (HasFatalFailure()) return;
-    ConnectionOptions options;
-    options.address = daemon_->address();
-    auto client = Client::Connect(options);
-    ASSERT_TRUE(client.ok()) << client.status();
-    client_.emplace(*std::move(client));
+    ConnectClient();
   }
 
   void Create(const v1::Map& map) {
@@ -83,13 +80,7 @@ class ClientLibraryTest : public DaemonTest {
     }
     ASSERT_TRUE((*session)->Close(absl::Seconds(60)).ok());
     EXPECT_EQ((*session)->totals().accepted, 2u * 7 * 24);
-    auto op = client_->RunUpdate(map);
-    ASSERT_TRUE(op.ok()) << op.status();
-    client::WaitOptions wait;
-    wait.poll_interval = absl::Milliseconds(50);
-    auto done = client_->WaitOperation(map, op->name(), wait);
-    ASSERT_TRUE(done.ok()) << done.status();
-    ASSERT_EQ(done->error().code(), 0) << done->error().message();
+    UpdateAndWait(map);
   }
 
   // Two weeks, each followed by the update: the first update publishes order 0 (no order has been
@@ -98,8 +89,6 @@ class ClientLibraryTest : public DaemonTest {
     IngestWeekAndUpdate(map, 0);
     IngestWeekAndUpdate(map, 1);
   }
-
-  std::optional<Client> client_;
 };
 
 // --- maps ---

@@ -120,6 +120,31 @@ TEST_F(FremenctlEvalTest, PeriodicModelBeatsTheMeanOnAPeriodicSignal) {
   }
 }
 
+TEST_F(FremenctlEvalTest, ReplayAddsTheOrderEachRuleSelects) {
+  const RunResult result = EvalSquareWave({"--replay"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  static const std::regex kRuleLine(R"((paper|margin|default)\t(\d+)\t(\d+\.\d+)\t(\d+\.\d+))");
+  std::istringstream lines(result.out);
+  std::vector<std::string> rules;
+  int table_lines = 0;
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (std::regex_match(line, m, kRuleLine)) {
+      rules.push_back(m[1]);
+      EXPECT_GE(std::stoi(m[2]), 1) << line;  // the daily component, by every rule
+      EXPECT_LT(std::stod(m[3]), 0.1) << line;
+    } else {
+      ++table_lines;
+      EXPECT_EQ(rules.size(), 0u) << "table line after the rules: " << line;
+    }
+  }
+  EXPECT_EQ(table_lines, 6);
+  EXPECT_EQ(rules, (std::vector<std::string>{"paper", "margin", "default"}));
+  // Without --replay, the table alone.
+  const RunResult plain = EvalSquareWave();
+  EXPECT_EQ(plain.out.find("paper"), std::string::npos);
+}
+
 // A bad training file: its contents (or none: the file is missing), and the line the error names
 // (0: the message names the file only).
 struct BadFile {

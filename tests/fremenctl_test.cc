@@ -108,6 +108,15 @@ TEST_F(FremenctlTest, MapsCreateListGetDelete) {
   ASSERT_EQ(get.exit_code, 0) << get.err;
   EXPECT_THAT(get.out, HasSubstr("max_order: 3"));
   EXPECT_THAT(get.out, HasSubstr("criterion: squared"));
+  EXPECT_THAT(get.out, HasSubstr("order_selection: weighted, temperature 0.01"));  // the default
+  RunResult margin = Run({"maps", "create", "gates", "--generic", "--order-selection", "margin", "--order-margin",
+                          "0.003", "--criterion", "threshold"});
+  ASSERT_EQ(margin.exit_code, 0) << margin.err;
+  EXPECT_THAT(Run({"maps", "get", "gates"}).out, HasSubstr("order_selection: margin 0.003"));
+  RunResult paper = Run({"maps", "create", "paper", "--generic", "--order-selection", "paper"});
+  ASSERT_EQ(paper.exit_code, 0) << paper.err;
+  EXPECT_THAT(Run({"maps", "get", "paper"}).out, HasSubstr("order_selection: paper"));
+  EXPECT_EQ(Run({"maps", "create", "bad", "--generic", "--order-selection", "best"}).exit_code, 2);
   RunResult json = Run({"maps", "get", "lab", "--json"});
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_THAT(json.out, HasSubstr("\"resolution\":0.5"));

@@ -22,6 +22,22 @@ struct EvalOptions {
   bool floor_periods = false;
   int max_order = model::kDefaultMaxOrder;
   bool persistence = false;
+  bool replay = false;
+};
+
+// The order rules --replay compares: the settings of maps made before the weighted rule (thresholded
+// errors, 7-day half-life) with the paper's exact minimum and with the 0.001 margin, and the
+// defaults of new maps.
+struct ReplayRule {
+  const char* name;
+  model::ErrorCriterion criterion;
+  double half_life;
+  model::OrderRule rule;
+};
+constexpr ReplayRule kReplayRules[] = {
+    {"paper", model::ErrorCriterion::kThreshold, 7 * 86400.0, model::OrderRule{model::OrderSelection::kPaper}},
+    {"margin", model::ErrorCriterion::kThreshold, 7 * 86400.0, model::OrderRule{model::OrderSelection::kMargin}},
+    {"default", model::kDefaultCriterion, model::kDefaultErrorHalfLife, model::OrderRule{}},
 };
 
 // Reports a failure on stderr and ends the program with `exit_code` (kExitFailure or kExitUsage).
@@ -48,6 +64,15 @@ void RunEval(const EvalOptions& options) {
   for (const OrderScore& score : EvaluateOffline(settings, *train, *test, options.persistence)) {
     std::printf("%d\t%.4f\t%.4f\n", score.order, score.err, score.mse);
   }
+  if (!options.replay) return;
+  for (const ReplayRule& r : kReplayRules) {
+    model::ModelSettings rule_settings = settings;
+    rule_settings.criterion = r.criterion;
+    rule_settings.error_half_life = r.half_life;
+    rule_settings.order_rule = r.rule;
+    const OrderScore score = EvaluateReplay(rule_settings, *train, *test);
+    std::printf("%s\t%d\t%.4f\t%.4f\n", r.name, score.order, score.err, score.mse);
+  }
 }
 
 }  // namespace
@@ -73,10 +98,17 @@ void RegisterEvalCommand(CLI::App& app) {
       ->capture_default_str();
   eval->add_flag("--persistence", options->persistence,
                  "Blend the last training observation into the predictions (persistence model)");
+  eval->add_flag("--replay", options->replay,
+                 "Also feed --train day by day with nightly updates, as the daemon sees it, and print the test "
+                 "scores of the order each rule selects (paper, margin, default)");
   eval->footer(
       "Trains one state on all of --train in one batch, then predicts every time of --test at each order\n"
       "0..L and prints one line per order: order<TAB>err<TAB>mse. err is the mean of |[p > 0.5] - s| (for 0/1\n"
       "states, the share of wrongly estimated samples), mse the mean of (p - s)^2.\n"
+      "With --replay, three more lines rule<TAB>order<TAB>err<TAB>mse: the order selected after a day-by-day\n"
+      "replay by the paper's rule (exact minimum of the thresholded errors, 7-day half-life), by the margin\n"
+      "rule of maps made before the weighted one (the same, a higher order wins by > 0.001) and by the\n"
+      "default of new maps (weighted rule on squared errors, 3-day half-life).\n"
       "Exit codes: 0 success, 1 unreadable or invalid data file (the message names file:line), 2 bad usage.\n"
       "\n"
       "Example, the setting of the original FremenServer's published figures:\n"

@@ -35,6 +35,9 @@ struct CreateArgs {
   std::optional<uint32_t> period_count;
   std::optional<double> half_life;
   std::string criterion;
+  std::string order_selection;
+  std::optional<double> order_margin;
+  std::optional<double> order_temperature;
   double lossless_sampling = 0;
   uint32_t shards = 0;
 };
@@ -77,6 +80,11 @@ void PrintMap(const v1::Map& map) {
   std::printf("persistence: %s\n", map.persistence() ? "on" : "off");
   std::printf("error_half_life: %g s\n", map.error_half_life_seconds());
   std::printf("criterion: %s\n", map.criterion() == v1::ERROR_CRITERION_SQUARED ? "squared" : "threshold");
+  switch (map.order_selection()) {
+    case v1::ORDER_SELECTION_MARGIN: std::printf("order_selection: margin %g\n", map.order_margin()); break;
+    case v1::ORDER_SELECTION_PAPER: std::printf("order_selection: paper\n"); break;
+    default: std::printf("order_selection: weighted, temperature %g\n", map.order_temperature()); break;
+  }
   if (map.lossless_sampling_seconds() > 0) {
     std::printf("lossless: every %g s from %g\n", map.lossless_sampling_seconds(), map.lossless_origin());
   } else {
@@ -115,6 +123,11 @@ v1::Map MapOf(const CreateArgs& a) {
   if (a.half_life) map.set_error_half_life_seconds(*a.half_life);
   if (a.criterion == "squared") map.set_criterion(v1::ERROR_CRITERION_SQUARED);
   if (a.criterion == "threshold") map.set_criterion(v1::ERROR_CRITERION_THRESHOLD);
+  if (a.order_selection == "margin") map.set_order_selection(v1::ORDER_SELECTION_MARGIN);
+  if (a.order_selection == "paper") map.set_order_selection(v1::ORDER_SELECTION_PAPER);
+  if (a.order_selection == "weighted") map.set_order_selection(v1::ORDER_SELECTION_WEIGHTED);
+  if (a.order_margin) map.set_order_margin(*a.order_margin);
+  if (a.order_temperature) map.set_order_temperature(*a.order_temperature);
   map.set_lossless_sampling_seconds(a.lossless_sampling);
   map.set_shards(a.shards);
   return map;
@@ -134,10 +147,19 @@ void RegisterCreate(CLI::App& maps) {
       ->check(CLI::PositiveNumber);
   create->add_option("--periods", a->period_count, "number of harmonics of the longest period (default 24)")
       ->check(CLI::PositiveNumber);
-  create->add_option("--half-life", a->half_life, "half-life of the order errors, seconds (default 7 days)")
+  create->add_option("--half-life", a->half_life, "half-life of the order errors, seconds (default 3 days)")
       ->check(CLI::NonNegativeNumber);
-  create->add_option("--criterion", a->criterion, "order-selection error: threshold (default) or squared")
+  create->add_option("--criterion", a->criterion, "order-selection error: squared (default) or threshold")
       ->check(CLI::IsMember({"threshold", "squared"}));
+  create->add_option("--order-selection", a->order_selection,
+                     "how the order is chosen from the decayed errors: weighted (default; the mean order of "
+                     "exp(-(r - r_min)/T) weights), margin (a higher order must win by --order-margin) or "
+                     "paper (the exact minimum)")
+      ->check(CLI::IsMember({"weighted", "margin", "paper"}));
+  create->add_option("--order-margin", a->order_margin, "margin rule: how much a higher order must win by (0.001)")
+      ->check(CLI::NonNegativeNumber);
+  create->add_option("--order-temperature", a->order_temperature, "weighted rule: the temperature T (0.01)")
+      ->check(CLI::PositiveNumber);
   create->add_option("--lossless-sampling", a->lossless_sampling, "keep lossless history sampled every S seconds")
       ->check(CLI::NonNegativeNumber);
   create->add_option("--shards", a->shards, "LMDB shards, 1..256 (default: the daemon's)")->check(CLI::Range(0, 256));

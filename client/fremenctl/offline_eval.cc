@@ -5,7 +5,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <algorithm>
 #include <fstream>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -90,29 +92,51 @@ absl::StatusOr<std::vector<model::Observation>> ReadObservations(const std::stri
   return ReadObservations(in, path);
 }
 
+namespace {
+
+// The scores of `order` of a published `state` on `test`.
+OrderScore ScoreOrder(const model::StateModel& state, const model::ModelSettings& settings, int order,
+                      const std::vector<model::Observation>& test, bool with_persistence) {
+  OrderScore score{order};
+  for (const model::Observation& o : test) {
+    const double p = state.Predict(model::PhasorTable(settings.periods, o.t), with_persistence, order);
+    score.err += std::fabs((p > 0.5 ? 1.0 : 0.0) - o.s);
+    score.mse += (p - o.s) * (p - o.s);
+  }
+  score.err /= test.size();
+  score.mse /= test.size();
+  return score;
+}
+
+}  // namespace
+
+OrderScore EvaluateReplay(const model::ModelSettings& settings, std::vector<model::Observation> train,
+                          const std::vector<model::Observation>& test) {
+  std::stable_sort(train.begin(), train.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
+  model::StateModel state(settings);
+  const auto day_of = [](double t) { return std::floor(t / 86400.0); };
+  for (size_t first = 0; first < train.size();) {
+    size_t end = first;
+    while (end < train.size() && day_of(train[end].t) == day_of(train[first].t)) ++end;
+    state.AddBatch(std::span(train).subspan(first, end - first));
+    state.Update();
+    first = end;
+  }
+  return ScoreOrder(state, settings, state.published().order(), test, false);
+}
+
 std::vector<OrderScore> EvaluateOffline(const model::ModelSettings& settings,
                                         const std::vector<model::Observation>& train,
                                         const std::vector<model::Observation>& test, bool with_persistence) {
   model::StateModel state(settings);
   state.AddBatch(train);
   // P holds the same L strongest components whatever its selected order, so one publication at L
-  // serves every order, and one phasor table per test time serves all of them.
+  // serves every order.
   state.Publish(settings.max_order);
 
-  std::vector<OrderScore> scores(settings.max_order + 1);
-  for (const model::Observation& o : test) {
-    const model::PhasorTable phasors(settings.periods, o.t);
-    for (int order = 0; order <= settings.max_order; ++order) {
-      const double p = state.Predict(phasors, with_persistence, order);
-      const double estimate = p > 0.5 ? 1.0 : 0.0;
-      scores[order].err += std::fabs(estimate - o.s);
-      scores[order].mse += (p - o.s) * (p - o.s);
-    }
-  }
+  std::vector<OrderScore> scores;
   for (int order = 0; order <= settings.max_order; ++order) {
-    scores[order].order = order;
-    scores[order].err /= test.size();
-    scores[order].mse /= test.size();
+    scores.push_back(ScoreOrder(state, settings, order, test, with_persistence));
   }
   return scores;
 }

@@ -43,4 +43,13 @@ std::vector<OrderScore> EvaluateOffline(const model::ModelSettings& settings,
                                         const std::vector<model::Observation>& train,
                                         const std::vector<model::Observation>& test, bool with_persistence);
 
+// The test scores of the order a rule selects when the training data are fed as the daemon sees
+// them: one batch per UTC day (day = floor(t / 86400)), each scored prequentially against the model
+// published the night before, then an update (order choice by `settings.criterion`,
+// `settings.error_half_life` and `settings.order_rule`, publication). The test data are predicted
+// with the last published model at its selected order, without persistence.
+// REQUIRES: `train` and `test` are not empty.
+OrderScore EvaluateReplay(const model::ModelSettings& settings, std::vector<model::Observation> train,
+                          const std::vector<model::Observation>& test);
+
 }  // namespace fremen::client

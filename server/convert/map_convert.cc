@@ -27,6 +27,9 @@ constexpr std::pair<absl::string_view, absl::string_view> kFieldNames[] = {
     {"grid.", "map.grid."},
     {"max_order", "map.max_order"},
     {"criterion", "map.criterion"},
+    {"order_selection", "map.order_selection"},
+    {"order_margin", "map.order_margin"},
+    {"order_temperature", "map.order_temperature"},
     {"shards", "map.shards"},
 };
 
@@ -41,7 +44,7 @@ absl::StatusOr<storage::MapKind> KindFromProto(v1::MapKind kind) {
 
 absl::StatusOr<model::ErrorCriterion> CriterionFromProto(v1::ErrorCriterion criterion) {
   switch (criterion) {
-    case v1::ERROR_CRITERION_UNSPECIFIED:
+    case v1::ERROR_CRITERION_UNSPECIFIED: return model::kDefaultCriterion;
     case v1::ERROR_CRITERION_THRESHOLD: return model::ErrorCriterion::kThreshold;
     case v1::ERROR_CRITERION_SQUARED: return model::ErrorCriterion::kSquared;
     default: return Invalid(absl::StrCat("map.criterion: unknown value ", static_cast<int>(criterion)));
@@ -51,6 +54,25 @@ absl::StatusOr<model::ErrorCriterion> CriterionFromProto(v1::ErrorCriterion crit
 v1::ErrorCriterion CriterionToProto(model::ErrorCriterion criterion) {
   return criterion == model::ErrorCriterion::kSquared ? v1::ERROR_CRITERION_SQUARED
                                                                : v1::ERROR_CRITERION_THRESHOLD;
+}
+
+absl::StatusOr<model::OrderSelection> SelectionFromProto(v1::OrderSelection selection) {
+  switch (selection) {
+    case v1::ORDER_SELECTION_UNSPECIFIED: return model::OrderRule{}.selection;
+    case v1::ORDER_SELECTION_MARGIN: return model::OrderSelection::kMargin;
+    case v1::ORDER_SELECTION_PAPER: return model::OrderSelection::kPaper;
+    case v1::ORDER_SELECTION_WEIGHTED: return model::OrderSelection::kWeighted;
+    default: return Invalid(absl::StrCat("map.order_selection: unknown value ", static_cast<int>(selection)));
+  }
+}
+
+v1::OrderSelection SelectionToProto(model::OrderSelection selection) {
+  switch (selection) {
+    case model::OrderSelection::kMargin: return v1::ORDER_SELECTION_MARGIN;
+    case model::OrderSelection::kPaper: return v1::ORDER_SELECTION_PAPER;
+    case model::OrderSelection::kWeighted: return v1::ORDER_SELECTION_WEIGHTED;
+  }
+  return v1::ORDER_SELECTION_UNSPECIFIED;
 }
 
 void GridFromProto(const v1::GridGeometry& grid, storage::GridGeometry& out) {
@@ -99,6 +121,11 @@ absl::StatusOr<storage::MapInfo> MapInfoFromProto(const v1::Map& map) {
   auto criterion = CriterionFromProto(map.criterion());
   if (!criterion.ok()) return criterion.status();
   info.criterion = *criterion;
+  auto selection = SelectionFromProto(map.order_selection());
+  if (!selection.ok()) return selection.status();
+  info.order_rule.selection = *selection;
+  if (map.has_order_margin()) info.order_rule.margin = map.order_margin();
+  if (map.has_order_temperature()) info.order_rule.temperature = map.order_temperature();
   info.lossless_sampling_period = map.lossless_sampling_seconds();
   info.lossless_origin = map.lossless_origin();
   info.shards = map.shards();
@@ -129,6 +156,9 @@ void MapInfoToProto(const storage::MapInfo& info, v1::Map& out) {
   out.set_persistence(info.persistence);
   out.set_error_half_life_seconds(info.error_half_life);
   out.set_criterion(CriterionToProto(info.criterion));
+  out.set_order_selection(SelectionToProto(info.order_rule.selection));
+  out.set_order_margin(info.order_rule.margin);
+  out.set_order_temperature(info.order_rule.temperature);
   out.set_lossless_sampling_seconds(info.lossless_sampling_period);
   out.set_lossless_origin(info.lossless_origin);
   out.set_shards(info.shards);

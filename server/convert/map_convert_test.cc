@@ -38,6 +38,9 @@ TEST(MapConvertTest, UnsetFieldsTakeTheDefaults) {
   EXPECT_EQ(info->persistence, defaults.persistence);
   EXPECT_EQ(info->error_half_life, defaults.error_half_life);
   EXPECT_EQ(info->criterion, defaults.criterion);
+  EXPECT_EQ(info->criterion, model::ErrorCriterion::kSquared);
+  EXPECT_EQ(info->order_rule, model::OrderRule{});
+  EXPECT_EQ(info->order_rule.selection, model::OrderSelection::kWeighted);
   EXPECT_EQ(info->lossless_sampling_period, 0);
 }
 
@@ -64,7 +67,8 @@ TEST(MapConvertTest, RoundTripsEveryField) {
   info.max_order = 3;
   info.persistence = false;
   info.error_half_life = 3600;
-  info.criterion = model::ErrorCriterion::kSquared;
+  info.criterion = model::ErrorCriterion::kThreshold;
+  info.order_rule = model::OrderRule{model::OrderSelection::kPaper, 0.25, 0.125};
   info.lossless_sampling_period = 60;
   info.lossless_origin = 1.7e9;
   info.shards = 4;
@@ -178,6 +182,15 @@ TEST(MapConvertTest, StorageErrorsUseTheProtoFieldNames) {
   map = GridMap();
   map.set_shards(257);
   EXPECT_THAT(ErrorOf(map), StartsWith("map.shards must be in [1, 256]"));
+  map = GridMap();
+  map.set_order_margin(-0.5);
+  EXPECT_THAT(ErrorOf(map), StartsWith("map.order_margin must be"));
+  map = GridMap();
+  map.set_order_temperature(0);
+  EXPECT_THAT(ErrorOf(map), StartsWith("map.order_temperature must be"));
+  map = GridMap();
+  map.set_order_selection(static_cast<v1::OrderSelection>(42));
+  EXPECT_THAT(ErrorOf(map), StartsWith("map.order_selection: unknown value 42"));
 }
 
 TEST(MapConvertTest, OnlyInvalidArgumentIsRenamed) {

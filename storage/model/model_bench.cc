@@ -298,13 +298,15 @@ void BM_Publish(benchmark::State& state) {
   }
   CompactModels models(kL, kScanCells);
   const Publisher publisher(Periods(), kL);
+  const OrderRule rule{static_cast<OrderSelection>(state.range(0))};
   for (auto _ : state) {
-    publisher.PublishRange(arena, errors, 0, kScanCells, models);
+    publisher.PublishRange(arena, errors, 0, kScanCells, models, rule);
     benchmark::ClobberMemory();
   }
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * kScanCells));
 }
-BENCHMARK(BM_Publish)->Unit(benchmark::kMillisecond);
+// Arg: the OrderSelection (0 margin, 1 paper, 2 weighted: L + 1 exp per state).
+BENCHMARK(BM_Publish)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
 // The single-state path for comparison: PublishedModel::FromSpectrum of a CompactSpectrum.
 void BM_PublishSingleStateReference(benchmark::State& state) {

@@ -9,7 +9,10 @@ namespace fremen::model {
 
 inline constexpr int kDefaultMaxOrder = 5;
 inline constexpr int kMaxMaxOrder = 64;
-inline constexpr double kDefaultErrorHalfLife = 7 * 86400.0;
+// The defaults of new maps (docs/model.md, "Order selection"): squared errors decayed with a 3-day
+// half-life, the weighted order rule. Maps created before the weighted rule keep what they stored.
+inline constexpr double kDefaultErrorHalfLife = 3 * 86400.0;
+inline constexpr ErrorCriterion kDefaultCriterion = ErrorCriterion::kSquared;
 
 struct ModelSettings {
   // Ω. Default: 604800/k s, k = 1..24.
@@ -19,10 +22,12 @@ struct ModelSettings {
   // Whether predictions may blend in the last observation (docs/model.md, "Persistence"). Default: on.
   bool persistence = true;
   // Half-life of the prequential error counters, seconds; 0 = count only since the last update.
-  // Longer remembers more evidence but adapts slower to a change of the dynamics. Default: 7 days.
+  // Longer remembers more evidence but adapts slower to a change of the dynamics. Default: 3 days.
   double error_half_life = kDefaultErrorHalfLife;
-  // How a prediction is scored against an observation. Default: thresholded error.
-  ErrorCriterion criterion = ErrorCriterion::kThreshold;
+  // How a prediction is scored against an observation. Default: squared error.
+  ErrorCriterion criterion = kDefaultCriterion;
+  // How the published order is chosen from the error rates. Default: weighted, temperature 0.01.
+  OrderRule order_rule;
 };
 
 }  // namespace fremen::model

@@ -29,14 +29,6 @@ void OrderErrors::Add(double t, const double* predictions, float s, ErrorCriteri
   }
 }
 
-int OrderErrors::BestOrder(double tie_margin) const {
-  int best = 0;
-  for (size_t l = 1; l < errors_.size(); ++l) {
-    if (ErrorRate(static_cast<int>(l)) < ErrorRate(best) - tie_margin) best = static_cast<int>(l);
-  }
-  return best;
-}
-
 void OrderErrors::Reset() {
   std::fill(errors_.begin(), errors_.end(), 0.0);
   weight_ = 0;

@@ -10,14 +10,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "storage/model/order_selection.h"
+
 namespace fremen::model {
 
 enum class ErrorCriterion : uint8_t {
   kThreshold = 0,  // |[p > 0.5] − s|: the share of wrong binary estimates
   kSquared = 1,    // (p − s)²
 };
-
-inline constexpr double kOrderTieMargin = 0.001;
 
 class OrderErrors {
  public:
@@ -26,10 +26,10 @@ class OrderErrors {
   int max_order() const { return static_cast<int>(errors_.size()) - 1; }
   // Scores one observation s at time t, given the unclamped predictions at orders 0..L.
   void Add(double t, const double* predictions, float s, ErrorCriterion criterion, double half_life);
-  // The order with the lowest decayed error rate; ties go to the lower order. Rates closer than
-  // `tie_margin` count as tied (a higher order must earn its parameters; the original code uses
-  // the same 0.001), which keeps sampling noise from choosing spurious components.
-  int BestOrder(double tie_margin = kOrderTieMargin) const;
+  // The order `rule` picks from the decayed error rates (order_selection.h).
+  int BestOrder(const OrderRule& rule) const {
+    return SelectOrder(errors_.data(), weight_, max_order(), rule);
+  }
   // The decayed error rate of order l (error per decayed observation); 0 before any observation.
   double ErrorRate(int order) const { return weight_ > 0 ? errors_[order] / weight_ : 0.0; }
   double weight() const { return weight_; }

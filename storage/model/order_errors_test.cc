@@ -11,10 +11,10 @@ TEST(OrderErrorsTest, TiesGoToTheLowerOrder) {
   OrderErrors errors(3);
   const double p[] = {0.9, 0.9, 0.1, 0.1};
   errors.Add(0, p, 1.0f, ErrorCriterion::kThreshold, 0);
-  EXPECT_EQ(errors.BestOrder(), 0);
+  EXPECT_EQ(errors.BestOrder(OrderRule{OrderSelection::kMargin}), 0);
   const double q[] = {0.1, 0.9, 0.9, 0.9};
   errors.Add(1, q, 1.0f, ErrorCriterion::kThreshold, 0);
-  EXPECT_EQ(errors.BestOrder(), 1);
+  EXPECT_EQ(errors.BestOrder(OrderRule{OrderSelection::kMargin}), 1);
 }
 
 TEST(OrderErrorsTest, ErrorsDecayWithTheHalfLife) {
@@ -27,7 +27,7 @@ TEST(OrderErrorsTest, ErrorsDecayWithTheHalfLife) {
   EXPECT_NEAR(errors.errors()[1], 0.5, 1e-12);  // one half-life old
   EXPECT_NEAR(errors.errors()[0], 1.0, 1e-12);
   EXPECT_NEAR(errors.weight(), 1.5, 1e-12);
-  EXPECT_EQ(errors.BestOrder(), 1);
+  EXPECT_EQ(errors.BestOrder(OrderRule{OrderSelection::kMargin}), 1);
   // An observation older than the reference time enters already decayed: the result does not
   // depend on arrival order.
   OrderErrors reversed(1);

@@ -352,7 +352,11 @@ TEST(RecordCodecTest, PrecisionIsPartOfTheSpectrumRecord) {
 }
 
 TEST(RecordCodecTest, CountsMustMatchTheMapSettings) {
+  // The settings of maps made before the weighted rule, under which this model's order is above 3.
   ModelSettings settings;
+  settings.criterion = ErrorCriterion::kThreshold;
+  settings.error_half_life = 7 * 86400.0;
+  settings.order_rule = OrderRule{OrderSelection::kMargin};
   const auto model = TrainedModel<double>(settings, 7);
   auto spectrum = DecodeSpectrum<double>(EncodeSpectrum(model.spectrum()), 23);
   ASSERT_FALSE(spectrum.ok());

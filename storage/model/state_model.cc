@@ -40,7 +40,7 @@ void BasicStateModel<Real>::AddBatch(std::span<const Observation> observations) 
 
 template <typename Real>
 int BasicStateModel<Real>::Update() {
-  const int order = errors_.BestOrder();
+  const int order = errors_.BestOrder(settings_->order_rule);
   Publish(order);
   return order;
 }

@@ -120,6 +120,12 @@ _CRITERIA = {
     "squared": maps_pb2.ERROR_CRITERION_SQUARED,
 }
 
+_ORDER_SELECTIONS = {
+    "weighted": maps_pb2.ORDER_SELECTION_WEIGHTED,
+    "margin": maps_pb2.ORDER_SELECTION_MARGIN,
+    "paper": maps_pb2.ORDER_SELECTION_PAPER,
+}
+
 
 class Client(AdminCalls):
     """Made by fremen.connect(). Usable as a context manager (closes the channel)."""
@@ -189,7 +195,9 @@ class Client(AdminCalls):
                    floor_periods: bool = False, periods: Optional[Sequence[float]] = None,
                    max_order: Optional[int] = None, persistence: Optional[bool] = None,
                    error_half_life: Optional[float] = None, criterion: Optional[str] = None,
-                   lossless_sampling: float = 0.0, lossless_origin: float = 0.0, shards: int = 0) -> MapInfo:
+                   order_selection: Optional[str] = None, order_margin: Optional[float] = None,
+                   order_temperature: Optional[float] = None, lossless_sampling: float = 0.0,
+                   lossless_origin: float = 0.0, shards: int = 0) -> MapInfo:
         """Creates a map and returns its MapInfo (every default filled in; its fields are named as
         these parameters).
 
@@ -197,8 +205,10 @@ class Client(AdminCalls):
         `origin` (x, y[, z]) metres; a generic map (states by id or name) otherwise. `kind` ("grid"
         or "generic") may say so explicitly. Model settings left None take the daemon's defaults:
         periods = `period_count` harmonics of `longest_period` seconds (24 of a week), or the
-        explicit list `periods`; `max_order` 5; `persistence` True; `error_half_life` a week;
-        `criterion` "threshold" or "squared"; `lossless_sampling` seconds (0 = no lossless
+        explicit list `periods`; `max_order` 5; `persistence` True; `error_half_life` 3 days;
+        `criterion` "squared" or "threshold"; `order_selection` "weighted" (the mean order under
+        weights exp(-(r - r_min)/`order_temperature`), temperature 0.01), "margin" (a higher order must
+        win by `order_margin`, 0.001) or "paper" (the exact minimum); `lossless_sampling` seconds (0 = no lossless
         history); `shards` 0 = the daemon's default.
         """
         if kind is None:
@@ -234,6 +244,15 @@ class Client(AdminCalls):
             if criterion not in _CRITERIA:
                 raise errors.InvalidArgument(f"criterion must be 'threshold' or 'squared', got {criterion!r}")
             spec.criterion = _CRITERIA[criterion]
+        if order_selection is not None:
+            if order_selection not in _ORDER_SELECTIONS:
+                raise errors.InvalidArgument(
+                    f"order_selection must be 'weighted', 'margin' or 'paper', got {order_selection!r}")
+            spec.order_selection = _ORDER_SELECTIONS[order_selection]
+        if order_margin is not None:
+            spec.order_margin = order_margin
+        if order_temperature is not None:
+            spec.order_temperature = order_temperature
         request = maps_pb2.CreateMapRequest(map=spec)
         return MapInfo.from_proto(self._call(self._maps.CreateMap, request, map_name, idempotent=False).map)
 

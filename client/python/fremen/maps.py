@@ -29,6 +29,9 @@ class MapInfo:
     persistence: Optional[bool]
     error_half_life: Optional[float]  # seconds
     criterion: str  # "threshold" or "squared"
+    order_selection: str  # "weighted", "margin" or "paper"
+    order_margin: Optional[float]  # the margin rule's margin
+    order_temperature: Optional[float]  # the weighted rule's temperature
     lossless_sampling: float  # seconds; 0 = no lossless history
     lossless_origin: float
     shards: int
@@ -53,9 +56,14 @@ class MapInfo:
             persistence=message.persistence if message.HasField("persistence") else None,
             error_half_life=(message.error_half_life_seconds if message.HasField("error_half_life_seconds")
                              else None),
-            # UNSPECIFIED is the daemon's default, THRESHOLD.
-            criterion=("threshold" if message.criterion == maps_pb2.ERROR_CRITERION_UNSPECIFIED
+            # UNSPECIFIED is the daemon's default, SQUARED (the daemon always answers with the value).
+            criterion=("squared" if message.criterion == maps_pb2.ERROR_CRITERION_UNSPECIFIED
                        else proto_values.word(maps_pb2.ErrorCriterion, message.criterion, "ERROR_CRITERION_")),
+            order_selection=("weighted" if message.order_selection == maps_pb2.ORDER_SELECTION_UNSPECIFIED
+                             else proto_values.word(maps_pb2.OrderSelection, message.order_selection,
+                                                    "ORDER_SELECTION_")),
+            order_margin=message.order_margin if message.HasField("order_margin") else None,
+            order_temperature=message.order_temperature if message.HasField("order_temperature") else None,
             lossless_sampling=message.lossless_sampling_seconds,
             lossless_origin=message.lossless_origin,
             shards=message.shards,

@@ -24,14 +24,18 @@ class MapsTest(DaemonTestCase):
         self.assertEqual(made.periods, [])
         self.assertEqual(made.max_order, 5)
         self.assertTrue(made.persistence)
-        self.assertEqual(made.criterion, "threshold")
+        self.assertEqual(made.criterion, "squared")
+        self.assertEqual(made.error_half_life, 3 * 86400)
+        self.assertEqual(made.order_selection, "weighted")
+        self.assertEqual(made.order_temperature, 0.01)
         self.assertGreater(made.create_time, 1.7e9)
         self.assertEqual(made.proto.grid.size.x, 40)  # the message it came from
 
     def test_create_grid_3d_and_generic_keep_every_setting(self):
         grid = self.client.create_map("cube", size=(10, 20, 4), resolution=0.25, longest_period=86400,
                                       period_count=6, floor_periods=True, max_order=3, persistence=False,
-                                      error_half_life=3600, criterion="squared", lossless_sampling=60,
+                                      error_half_life=3600, criterion="threshold", order_selection="margin",
+                                      order_margin=0.003, lossless_sampling=60,
                                       lossless_origin=1.7e9, shards=3)
         self.assertEqual(grid.size, (10, 20, 4))
         self.assertEqual(grid.longest_period, 86400)
@@ -40,7 +44,11 @@ class MapsTest(DaemonTestCase):
         self.assertEqual(grid.max_order, 3)
         self.assertFalse(grid.persistence)
         self.assertEqual(grid.error_half_life, 3600)
-        self.assertEqual(grid.criterion, "squared")
+        self.assertEqual(grid.criterion, "threshold")
+        self.assertEqual(grid.order_selection, "margin")
+        self.assertEqual(grid.order_margin, 0.003)
+        paper = self.client.create_map("paper", order_selection="paper", order_temperature=0.5)
+        self.assertEqual((paper.order_selection, paper.order_temperature), ("paper", 0.5))
         self.assertEqual(grid.lossless_sampling, 60)
         self.assertEqual(grid.lossless_origin, 1.7e9)
         self.assertEqual(grid.shards, 3)
@@ -104,6 +112,11 @@ class MapsTest(DaemonTestCase):
             self.client.create_map("lab", kind="cube")
         with self.assertRaises(fremen.InvalidArgument):
             self.client.create_map("lab", criterion="best")
+        with self.assertRaises(fremen.InvalidArgument):
+            self.client.create_map("lab", order_selection="best")
+        with self.assertRaises(fremen.InvalidArgument) as raised:  # refused by the daemon
+            self.client.create_map("lab", order_temperature=0)
+        self.assertIn("map.order_temperature", raised.exception.message)
 
     def test_a_daemon_that_is_gone_is_unavailable(self):
         self.stop_daemon()

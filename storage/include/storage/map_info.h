@@ -65,9 +65,13 @@ struct MapInfo {
   // L. Default 5, at most 64.
   uint32_t max_order = model::kDefaultMaxOrder;
   bool persistence = true;
-  // Seconds; 0 = errors since the last update only. Default: 7 days.
+  // Seconds; 0 = errors since the last update only. Default: 3 days.
   double error_half_life = model::kDefaultErrorHalfLife;
-  model::ErrorCriterion criterion = model::ErrorCriterion::kThreshold;
+  model::ErrorCriterion criterion = model::kDefaultCriterion;
+  // How the published order is chosen (docs/model.md, "Order selection"). Default: weighted, T = 0.01.
+  // Maps recorded before the rule was a setting (map info version 1) read as margin 0.001, the rule
+  // they were made with.
+  model::OrderRule order_rule;
   // Lossless history (docs/model.md, "Lossless history") with this sampling period in seconds;
   // 0 = off. Default: off.
   double lossless_sampling_period = 0;

@@ -5,12 +5,9 @@
 
 namespace fremen::model {
 
-int OrderErrorTable::BestOrder(size_t i, double tie_margin) const {
-  int best = 0;
-  for (int l = 1; l <= max_order_; ++l) {
-    if (ErrorRate(i, l) < ErrorRate(i, best) - tie_margin) best = l;
-  }
-  return best;
+int OrderErrorTable::BestOrder(size_t i, const OrderRule& rule) const {
+  const double* r = rec(i);
+  return SelectOrder(r + kErrors, r[kWeight], max_order_, rule);
 }
 
 void OrderErrorTable::Reset(size_t i) {

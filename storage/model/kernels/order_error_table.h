@@ -72,7 +72,7 @@ class OrderErrorTable {
   inline void Add(size_t i, const double* predictions, float s, ErrorCriterion criterion, ScanDecay& decay);
 
   // The order with the lowest decayed error rate, as OrderErrors::BestOrder.
-  int BestOrder(size_t i, double tie_margin = kOrderTieMargin) const;
+  int BestOrder(size_t i, const OrderRule& rule) const;
   double ErrorRate(size_t i, int order) const {
     const double* r = rec(i);
     return r[kWeight] > 0 ? r[kErrors + order] / r[kWeight] : 0.0;

@@ -29,8 +29,10 @@ void ExpectSameAsOrderErrors(ErrorCriterion criterion, double half_life) {
   }
   for (size_t i = 0; i < 4; ++i) {
     EXPECT_EQ(table.Get(i), reference[i]);
-    EXPECT_EQ(table.BestOrder(i), reference[i].BestOrder());
-    EXPECT_EQ(table.BestOrder(i, 0), reference[i].BestOrder(0));
+    for (const OrderRule& rule : {OrderRule{}, OrderRule{OrderSelection::kMargin}, OrderRule{OrderSelection::kPaper},
+                                  OrderRule{OrderSelection::kWeighted, 0, 0.1}}) {
+      EXPECT_EQ(table.BestOrder(i, rule), reference[i].BestOrder(rule));
+    }
     for (int l = 0; l <= kL; ++l) EXPECT_EQ(table.ErrorRate(i, l), reference[i].ErrorRate(l));
   }
 }
@@ -49,7 +51,7 @@ TEST(OrderErrorTableTest, RecordIsOneLineAtDefaultOrderAndRoundTrips) {
   errors.Restore(5.0, 2.0, {1.0, 0.5, 0.25});
   table.Set(1, errors);
   EXPECT_EQ(table.Get(1), errors);
-  EXPECT_EQ(table.BestOrder(1), errors.BestOrder());
+  EXPECT_EQ(table.BestOrder(1, OrderRule{}), errors.BestOrder(OrderRule{}));
   table.Reset(1);
   errors.Reset();
   EXPECT_EQ(table.Get(1), errors);

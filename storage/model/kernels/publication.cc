@@ -100,13 +100,13 @@ void Publisher::PublishRecords(const RecordArena& spectra, size_t first, size_t 
 }
 
 void Publisher::PublishRange(const RecordArena& spectra, const OrderErrorTable& errors, size_t first, size_t count,
-                             CompactModels& models, double tie_margin) const {
-  PublishRecords(spectra, first, count, models, [&](size_t i) { return errors.BestOrder(i, tie_margin); });
+                             CompactModels& models, const OrderRule& rule) const {
+  PublishRecords(spectra, first, count, models, [&](size_t i) { return errors.BestOrder(i, rule); });
 }
 
 void Publisher::PublishRange(const RecordArena& spectra, std::span<const OrderErrors> errors, size_t first,
-                             size_t count, CompactModels& models, double tie_margin) const {
-  PublishRecords(spectra, first, count, models, [&](size_t i) { return errors[i].BestOrder(tie_margin); });
+                             size_t count, CompactModels& models, const OrderRule& rule) const {
+  PublishRecords(spectra, first, count, models, [&](size_t i) { return errors[i].BestOrder(rule); });
 }
 
 }  // namespace fremen::model

@@ -36,11 +36,11 @@ class Publisher {
   void Publish(const CompactSpectrum& spectrum, int order, CompactModels& models, size_t out) const;
 
   // Records [first, first + count) of `spectra` into the same records of `models`, each at the order
-  // its error counters choose (BestOrder with `tie_margin`).
+  // its error counters choose (BestOrder with `rule`).
   void PublishRange(const RecordArena& spectra, const OrderErrorTable& errors, size_t first, size_t count,
-                    CompactModels& models, double tie_margin = kOrderTieMargin) const;
+                    CompactModels& models, const OrderRule& rule) const;
   void PublishRange(const RecordArena& spectra, std::span<const OrderErrors> errors, size_t first, size_t count,
-                    CompactModels& models, double tie_margin = kOrderTieMargin) const;
+                    CompactModels& models, const OrderRule& rule) const;
 
  private:
   template <typename OrderOf>
@@ -53,12 +53,12 @@ class Publisher {
 
 // Every record of `spectra`. REQUIRES: errors and models at least as many records.
 inline void PublishAll(const RecordArena& spectra, const OrderErrorTable& errors, const PeriodSet& periods,
-                       CompactModels& models, double tie_margin = kOrderTieMargin) {
-  Publisher(periods, models.max_order()).PublishRange(spectra, errors, 0, spectra.size(), models, tie_margin);
+                       CompactModels& models, const OrderRule& rule) {
+  Publisher(periods, models.max_order()).PublishRange(spectra, errors, 0, spectra.size(), models, rule);
 }
 inline void PublishAll(const RecordArena& spectra, std::span<const OrderErrors> errors, const PeriodSet& periods,
-                       CompactModels& models, double tie_margin = kOrderTieMargin) {
-  Publisher(periods, models.max_order()).PublishRange(spectra, errors, 0, spectra.size(), models, tie_margin);
+                       CompactModels& models, const OrderRule& rule) {
+  Publisher(periods, models.max_order()).PublishRange(spectra, errors, 0, spectra.size(), models, rule);
 }
 
 }  // namespace fremen::model

@@ -38,12 +38,14 @@ TEST_P(PublicationTest, EqualsFromSpectrumWithTheBestOrder) {
     table.Set(i, errors.back());
   }
   CompactModels from_table(c.max_order, spectra.size()), from_objects(c.max_order, spectra.size());
-  PublishAll(arena, table, periods, from_table);
-  PublishAll(arena, errors, periods, from_objects);
+  // The paper's rule: RandomOrderErrors is made so that its minima cover every order.
+  const OrderRule rule{OrderSelection::kPaper};
+  PublishAll(arena, table, periods, from_table, rule);
+  PublishAll(arena, errors, periods, from_objects, rule);
 
   std::vector<int> orders_seen(c.max_order + 1);
   for (size_t i = 0; i < spectra.size(); ++i) {
-    const int order = errors[i].BestOrder();
+    const int order = errors[i].BestOrder(rule);
     ++orders_seen[order];
     const PublishedModel want = PublishedModel::FromSpectrum(spectra[i], periods, c.max_order, order);
     ASSERT_TRUE(from_table.Holds(i, want)) << "cell " << i;

@@ -127,7 +127,7 @@ TEST_P(ScoredScanTest, ScoreAndApplyScanEqualsStateModelObserve) {
   for (size_t i = 0; i < kCells; ++i) {
     ExpectSameSpectrum(arena, i, reference[i].spectrum());
     EXPECT_EQ(errors.Get(i), reference[i].order_errors()) << "cell " << i;
-    scored_orders += errors.BestOrder(i) > 0;
+    scored_orders += errors.BestOrder(i, settings.order_rule) > 0;
   }
   EXPECT_GT(scored_orders, 0);  // the test exercised more than order 0
 }
