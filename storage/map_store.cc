@@ -159,6 +159,9 @@ absl::Status MapStoreImpl::Recover() {
     }
     auto batch = DecodeBatch({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1});
     if (!batch.ok()) return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", batch.status().message()));
+    if (absl::Status expanded = ExpandCompact(info_, *batch); !expanded.ok()) {
+      return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", expanded.message()));
+    }
     dedup_.Record(batch->writer_id, batch->sequence,
                   BatchFingerprint({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1}));
     Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}, {}};

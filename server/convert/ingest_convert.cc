@@ -188,6 +188,14 @@ absl::Status FromPatch(const v1::DensePatch& patch, ObservationBatch& batch) {
   return absl::OkStatus();
 }
 
+// The bytes as they came (the log keeps them), then their expansion into keys and values.
+absl::Status FromCompact(const MapInfo& map, const v1::CompactCells& compact, ObservationBatch& batch) {
+  batch.compact.indices = compact.indices();
+  batch.compact.occupied = compact.occupied();
+  batch.compact.probabilities = compact.probabilities();
+  return storage::ExpandCompact(map, batch);
+}
+
 absl::Status FillObservations(const MapInfo& map, const v1::IngestRequest& request, ObservationBatch& batch) {
   switch (request.observations_case()) {
     case v1::IngestRequest::kCells:
@@ -199,6 +207,9 @@ absl::Status FillObservations(const MapInfo& map, const v1::IngestRequest& reque
     case v1::IngestRequest::kPatch:
       if (auto s = CheckKind(map, "patch observations", MapKind::kGrid); !s.ok()) return s;
       return FromPatch(request.patch(), batch);
+    case v1::IngestRequest::kCompact:
+      if (auto s = CheckKind(map, "compact cells", MapKind::kGrid); !s.ok()) return s;
+      return FromCompact(map, request.compact(), batch);
     case v1::IngestRequest::kStates:
       if (auto s = CheckKind(map, "states by id", MapKind::kGeneric); !s.ok()) return s;
       return FromStates(request.states(), batch);
@@ -208,7 +219,7 @@ absl::Status FillObservations(const MapInfo& map, const v1::IngestRequest& reque
     case v1::IngestRequest::OBSERVATIONS_NOT_SET:
       break;
   }
-  return Invalid("observations are required: one of cells, points, states, named_states or patch");
+  return Invalid("observations are required: one of cells, points, states, named_states, patch or compact");
 }
 
 v1::RejectReason ReasonToProto(storage::RejectReason reason) {
