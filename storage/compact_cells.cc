@@ -53,6 +53,10 @@ absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& ce
   const GridKeys layout = grid.keys();
   const uint64_t cell_count = grid.cell_count();
   const uint32_t nx = grid.size[0];
+  // The key's x bits (Morton: every third bit in 3-D, every second in 2-D). A step of one along x
+  // adds 1 to them alone: set the other bits so that the carry skips them, add, keep the x bits.
+  const uint64_t x_bits = layout.flat() ? 0x5555555555555555ull : 0x1249249249249249ull;
+  uint64_t key = 0;
   uint64_t index = 0;
   std::array<uint32_t, 3> cell = {0, 0, 0};
   bool outside = false;  // index ≥ cell_count: this and every later cell
@@ -86,11 +90,17 @@ absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& ce
       // Along a row the cell moves in x alone; a gap that leaves the row is recomputed.
       if (gap < nx - cell[0]) {
         cell[0] += static_cast<uint32_t>(gap);
+        if (gap == 1) {  // the common step of a coherent scan: the key's x bits plus one
+          key = (key & ~x_bits) | (((key | ~x_bits) + 1) & x_bits);
+          keys[i] = key;
+          continue;
+        }
       } else {
         cell = CellOfIndex(grid, index);
       }
     }
-    keys[i] = outside ? kNotACellKey : layout.Key(cell[0], cell[1], cell[2]);
+    key = outside ? kNotACellKey : layout.Key(cell[0], cell[1], cell[2]);
+    keys[i] = key;
   }
   if (soft) {
     const auto* bytes = reinterpret_cast<const uint8_t*>(cells.probabilities.data());
