@@ -105,11 +105,8 @@ TEST(CompactCellsTest, CellsPastTheGridGetNoCellsKeyAndClassifyRejectsThemAsOuts
   EXPECT_EQ(batch.keys[3], kNotACellKey);
   std::vector<uint8_t> accept;
   const BatchAck ack = Classify(map, batch, accept);
-  EXPECT_EQ(ack.accepted, 2u);
-  EXPECT_EQ(ack.rejected, 2u);
-  ASSERT_EQ(ack.rejections.size(), 2u);
-  EXPECT_EQ(ack.rejections[0].index, 2u);
-  EXPECT_EQ(ack.rejections[0].reason, RejectReason::kOutsideMap);
+  EXPECT_EQ(accept, (std::vector<uint8_t>{1, 1, 0, 0}));
+  for (const Rejection& r : ack.rejections) EXPECT_EQ(r.reason, RejectReason::kOutsideMap) << r.index;
 }
 
 TEST(CompactCellsTest, ABatchLogsItsCompactBytesAndDecodesBackToThem) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -89,27 +90,31 @@ v1::IngestRequest AsCompact(const std::string& map, uint64_t sequence, const Tes
 
 class CompactIngestTest : public DaemonTest {
  protected:
-  void SetUp() override {
-    DaemonTest::SetUp();
-    if (!HasFatalFailure()) Connect();
-  }
-  void Connect() {
-    channel_ = daemon_->NewChannel();
-    maps_ = v1::MapService::NewStub(channel_);
-    ingest_ = v1::IngestService::NewStub(channel_);
-    query_ = v1::QueryService::NewStub(channel_);
+  // The stubs on a channel to the daemon running now (again after a restart).
+  struct Stubs {
+    explicit Stubs(const std::shared_ptr<grpc::Channel>& channel)
+        : maps(v1::MapService::NewStub(channel)),
+          ingest(v1::IngestService::NewStub(channel)),
+          query(v1::QueryService::NewStub(channel)) {}
+    std::unique_ptr<v1::MapService::Stub> maps;
+    std::unique_ptr<v1::IngestService::Stub> ingest;
+    std::unique_ptr<v1::QueryService::Stub> query;
+  };
+  Stubs& stubs() {
+    if (!stubs_) stubs_.emplace(daemon_->NewChannel());
+    return *stubs_;
   }
   void Create(const v1::Map& map) {
     v1::CreateMapRequest request;
     *request.mutable_map() = map;
     v1::CreateMapResponse response;
-    const grpc::Status status = maps_->CreateMap(CallContext().get(), request, &response);
+    const grpc::Status status = stubs().maps->CreateMap(CallContext().get(), request, &response);
     ASSERT_TRUE(status.ok()) << status.error_message();
   }
   // Sends the batches on one stream; their responses.
   std::vector<v1::IngestResponse> Send(const std::vector<v1::IngestRequest>& batches) {
     auto context = CallContext();
-    auto stream = ingest_->Ingest(context.get());
+    auto stream = stubs().ingest->Ingest(context.get());
     std::vector<v1::IngestResponse> responses;
     for (const auto& b : batches) {
       EXPECT_TRUE(stream->Write(b));
@@ -134,7 +139,7 @@ class CompactIngestTest : public DaemonTest {
           request.mutable_state()->mutable_cell()->set_z(z);
           request.set_include_spectrum(true);
           v1::GetStateModelResponse response;
-          const grpc::Status status = query_->GetStateModel(CallContext().get(), request, &response);
+          const grpc::Status status = stubs().query->GetStateModel(CallContext().get(), request, &response);
           EXPECT_TRUE(status.ok()) << status.error_message();
           out.push_back(response.model().SerializeAsString());
         }
@@ -143,10 +148,7 @@ class CompactIngestTest : public DaemonTest {
     return out;
   }
 
-  std::shared_ptr<grpc::Channel> channel_;
-  std::unique_ptr<v1::MapService::Stub> maps_;
-  std::unique_ptr<v1::IngestService::Stub> ingest_;
-  std::unique_ptr<v1::QueryService::Stub> query_;
+  std::optional<Stubs> stubs_;  // reset when the daemon restarts
 };
 
 TEST_F(CompactIngestTest, CompactScansGiveModelsBitIdenticalToCellObservationsAlsoAfterKill9) {
@@ -178,9 +180,9 @@ TEST_F(CompactIngestTest, CompactScansGiveModelsBitIdenticalToCellObservationsAl
 
   // Recovery replays the compact log records into the same models; retries stay duplicates.
   daemon_->Kill();
+  stubs_.reset();
   StartDaemon();
   ASSERT_FALSE(HasFatalFailure());
-  Connect();
   EXPECT_EQ(Models("compact"), want);
   const auto again = Send({compact[4]});
   EXPECT_TRUE(again[0].duplicate());
