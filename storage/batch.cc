@@ -72,7 +72,9 @@ absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch) {
 absl::Status ExpandCompact(const MapInfo& map, ObservationBatch& batch) {
   if (batch.compact.empty()) return absl::OkStatus();
   if (map.kind != MapKind::kGrid) return absl::InvalidArgumentError("compact cells are only for grid maps");
-  return ExpandCompactCells(map.grid, batch.compact, kMaxBatchObservations, batch.keys, batch.values);
+  absl::Status expanded = ExpandCompactCells(map.grid, batch.compact, kMaxBatchObservations, batch.keys, batch.values);
+  batch.keys_from_grid.set = expanded.ok();
+  return expanded;
 }
 
 BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector<uint8_t>& accept) {
@@ -85,9 +87,12 @@ BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector
     if (ack.rejections.size() < kMaxReportedRejections) ack.rejections.push_back({static_cast<uint32_t>(i), reason});
   };
   const GridKeys keys = map.grid.keys();
+  const bool from_grid = map.kind == MapKind::kGrid && batch.keys_from_grid.set;
   for (size_t i = 0; i < batch.keys.size(); ++i) {
     if (!ValueOk(batch.values[i])) {
       reject(i, RejectReason::kValueOutOfRange);
+    } else if (from_grid) {
+      if (batch.keys[i] == kNotACellKey) reject(i, RejectReason::kOutsideMap);
     } else if (map.kind == MapKind::kGrid) {
       const auto cell = keys.Cell(batch.keys[i]);
       if (!keys.IsCellKey(batch.keys[i]) || !map.grid.Contains(cell[0], cell[1], cell[2])) {

@@ -87,6 +87,7 @@ absl::Status FromCells(const MapInfo& map, const v1::CellObservations& cells, Ob
   const auto fill = flat ? (z.empty() ? CellKeys<true, false> : CellKeys<true, true>)
                          : (z.empty() ? CellKeys<false, false> : CellKeys<false, true>);
   fill(map.grid, x.data(), y.data(), z.data(), n, batch.keys.data());
+  batch.keys_from_grid.set = true;
   CopyValues(cells.values(), batch);
   return absl::OkStatus();
 }
@@ -107,6 +108,7 @@ absl::Status FromPoints(const MapInfo& map, const v1::PointObservations& points,
     const auto cell = map.grid.CellOf(x[i], y[i], z.empty() ? 0.0 : z[i]);
     batch.keys[i] = cell ? keys.Key((*cell)[0], (*cell)[1], (*cell)[2]) : kOutsideMapKey;
   }
+  batch.keys_from_grid.set = true;
   CopyValues(points.values(), batch);
   return absl::OkStatus();
 }

@@ -45,6 +45,15 @@ struct ObservationBatch {
   // Cells in the API's compact form, when they came so: keys and values are then its expansion
   // (ExpandCompact), and the log keeps this form instead of them.
   CompactCells compact;
+  // Set by what made the keys from cell indices (the API's conversions, ExpandCompact): every key
+  // is a cell's inside the grid or kNotACellKey, so that Classify need not decode each key to
+  // check it (a tenth of the ingest path's instructions). Not content: neither logged nor compared;
+  // a batch decoded from a version 1 record has it unset and is checked key by key, to the same
+  // result.
+  struct KeysFromGrid {
+    bool set = false;
+    bool operator==(const KeysFromGrid&) const { return true; }
+  } keys_from_grid;
   DensePatch patch;           // empty when size has a zero
   std::vector<StateLabel> labels;
 
