@@ -136,5 +136,20 @@ TEST(CompactCellsTest, ABatchLogsItsCompactBytesAndDecodesBackToThem) {
   }
 }
 
+// The version 2 layout byte by byte (docs/storage.md, "Batch record"; fuzz/corpus/batch/batch_compact
+// holds these bytes): a change of the format must be deliberate, old logs hold it.
+TEST(CompactCellsTest, TheCompactRecordLayoutIsFixed) {
+  ObservationBatch batch;
+  batch.writer_id = 5;
+  batch.sequence = 10;
+  batch.time = 1.7e9;
+  batch.compact = {std::string("\x03\x01\x01\x04", 4), std::string("\x0b", 1), ""};
+  std::string want = std::string("\x02\x05\x0a", 3);
+  const double time = 1.7e9;
+  want.append(reinterpret_cast<const char*>(&time), 8);  // little-endian, as the log
+  want += std::string("\x04\x03\x01\x01\x04", 5) + std::string("\x00\x01\x0b", 3) + std::string(7, '\0');
+  EXPECT_EQ(EncodeBatch(batch), want);
+}
+
 }  // namespace
 }  // namespace fremen::storage
