@@ -241,6 +241,12 @@ void LogSeeds() {
     Seed("batch", "batch" + std::to_string(i), Byte(i == 2 ? 2 : 0) + payload);
     log += WalRecord(i + 1, payload);
   }
+  // A compact batch (version 2 record): cells 3, 4, 5 and 9 by linear index, occupied bits.
+  storage::ObservationBatch compact = Batch(0);
+  compact.keys.clear();
+  compact.values.clear();
+  compact.compact = {std::string("\x03\x01\x01\x04", 4), std::string("\x0b", 1), ""};
+  Seed("batch", "batch_compact", Byte(0) + storage::EncodeBatch(compact));
   Seed("wal_replay", "three_records", Byte(0) + Byte(0) + log);
   Seed("wal_replay", "three_records_fix_crc", Byte(3) + Byte(0) + log);
   Seed("wal_replay", "two_segments_after_1", Byte(16 | 4) + Byte(1) + log);

@@ -13,6 +13,8 @@ namespace fremen::storage {
 
 namespace {
 constexpr uint8_t kBatchVersion = 1;
+constexpr uint8_t kCompactBatchVersion = 2;  // compact cells instead of keys and values
+constexpr uint8_t kCompactOccupied = 0, kCompactProbabilities = 1;
 // A batch is one message of at most a few hundred MB; more observations than this is corruption.
 constexpr uint64_t kMaxBatchObservations = 1ull << 28;
 
@@ -31,6 +33,9 @@ absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch) {
   if (batch.keys.size() != batch.values.size()) {
     return absl::InvalidArgumentError(absl::StrCat("values must hold one value per state: ", batch.values.size(),
                                                    " values for ", batch.keys.size(), " states"));
+  }
+  if (!batch.compact.empty() && batch.keys.empty()) {
+    return absl::InternalError("compact cells must be expanded (ExpandCompact) before the batch is submitted");
   }
   const DensePatch& patch = batch.patch;
   const uint64_t patch_cells = uint64_t{patch.size[0]} * patch.size[1] * patch.size[2];
@@ -64,6 +69,14 @@ absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch) {
   return absl::OkStatus();
 }
 
+absl::Status ExpandCompact(const MapInfo& map, ObservationBatch& batch) {
+  if (batch.compact.empty()) return absl::OkStatus();
+  if (map.kind != MapKind::kGrid) return absl::InvalidArgumentError("compact cells are only for grid maps");
+  absl::Status expanded = ExpandCompactCells(map.grid, batch.compact, kMaxBatchObservations, batch.keys, batch.values);
+  batch.keys_from_grid.set = expanded.ok();
+  return expanded;
+}
+
 BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector<uint8_t>& accept) {
   BatchAck ack;
   ack.sequence = batch.sequence;
@@ -74,9 +87,12 @@ BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector
     if (ack.rejections.size() < kMaxReportedRejections) ack.rejections.push_back({static_cast<uint32_t>(i), reason});
   };
   const GridKeys keys = map.grid.keys();
+  const bool from_grid = map.kind == MapKind::kGrid && batch.keys_from_grid.set;
   for (size_t i = 0; i < batch.keys.size(); ++i) {
     if (!ValueOk(batch.values[i])) {
       reject(i, RejectReason::kValueOutOfRange);
+    } else if (from_grid) {
+      if (batch.keys[i] == kNotACellKey) reject(i, RejectReason::kOutsideMap);
     } else if (map.kind == MapKind::kGrid) {
       const auto cell = keys.Cell(batch.keys[i]);
       if (!keys.IsCellKey(batch.keys[i]) || !map.grid.Contains(cell[0], cell[1], cell[2])) {
@@ -91,17 +107,54 @@ BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector
   return ack;
 }
 
+namespace {
+
+void PutBytes(std::string* out, std::string_view bytes) {
+  model::PutVarint64(out, bytes.size());
+  out->append(bytes);
+}
+
+// What follows the keys and values in both versions: the patch and the labels.
+void EncodePatchAndLabels(const ObservationBatch& batch, std::string& out) {
+  for (uint32_t o : batch.patch.origin) model::PutVarint64(&out, o);
+  for (uint32_t s : batch.patch.size) model::PutVarint64(&out, s);
+  model::PutFloats(&out, batch.patch.values);
+  model::PutVarint64(&out, batch.labels.size());
+  for (const StateLabel& label : batch.labels) {
+    model::PutVarint64(&out, label.key);
+    PutBytes(&out, label.name);
+    PutBytes(&out, label.group);
+  }
+}
+
+}  // namespace
+
 // Layout (version 1): version u8 | writer varint | sequence varint | time f64 |
 // key count varint | keys (delta-zigzag varints: scans are spatially sorted, so deltas are small) |
 // values f32 each | patch origin 3×varint | patch size 3×varint | patch values f32 each |
 // label count varint | labels (key varint, name, group as length-prefixed bytes).
+// Version 2 (compact cells): version u8 | writer | sequence | time | compact.indices as
+// length-prefixed bytes | value kind u8 (0 occupied bits, 1 probability bytes) | the values as
+// length-prefixed bytes | then as version 1 from the patch on.
 std::string EncodeBatch(const ObservationBatch& batch) {
   std::string out;
-  out.reserve(32 + batch.keys.size() * model::kMaxVarint64Bytes + batch.observation_count() * 4);
-  out.push_back(static_cast<char>(kBatchVersion));
+  const bool compact = !batch.compact.empty();
+  out.reserve(32 + (compact ? batch.compact.indices.size() + batch.compact.occupied.size() +
+                                  batch.compact.probabilities.size()
+                            : batch.keys.size() * model::kMaxVarint64Bytes + batch.keys.size() * 4) +
+              batch.patch.values.size() * 4);
+  out.push_back(static_cast<char>(compact ? kCompactBatchVersion : kBatchVersion));
   model::PutVarint64(&out, batch.writer_id);
   model::PutVarint64(&out, batch.sequence);
   model::PutDouble(&out, batch.time);
+  if (compact) {
+    const bool soft = !batch.compact.probabilities.empty();
+    PutBytes(&out, batch.compact.indices);
+    out.push_back(static_cast<char>(soft ? kCompactProbabilities : kCompactOccupied));
+    PutBytes(&out, soft ? batch.compact.probabilities : batch.compact.occupied);
+    EncodePatchAndLabels(batch, out);
+    return out;
+  }
   model::PutVarint64(&out, batch.keys.size());
   // The keys' deltas into room for the longest varints, then cut to what they took.
   const size_t keys_at = out.size();
@@ -114,30 +167,36 @@ std::string EncodeBatch(const ObservationBatch& batch) {
   }
   out.resize(end - out.data());
   model::PutFloats(&out, batch.values);
-  for (uint32_t o : batch.patch.origin) model::PutVarint64(&out, o);
-  for (uint32_t s : batch.patch.size) model::PutVarint64(&out, s);
-  model::PutFloats(&out, batch.patch.values);
-  model::PutVarint64(&out, batch.labels.size());
-  for (const StateLabel& label : batch.labels) {
-    model::PutVarint64(&out, label.key);
-    model::PutVarint64(&out, label.name.size());
-    out += label.name;
-    model::PutVarint64(&out, label.group.size());
-    out += label.group;
-  }
+  EncodePatchAndLabels(batch, out);
   return out;
 }
 
 absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes) {
   model::ByteReader r(bytes, "batch");
   ObservationBatch batch;
-  if (const uint8_t version = r.Byte("version"); r.ok() && version != kBatchVersion) {
+  const uint8_t version = r.Byte("version");
+  if (r.ok() && version != kBatchVersion && version != kCompactBatchVersion) {
     r.Fail("version", absl::StrCat("unknown version ", version));
   }
   batch.writer_id = r.Varint("writer_id");
   batch.sequence = r.Varint("sequence");
   batch.time = r.Double("time");
-  const uint64_t key_count = r.Varint("key count");
+  if (version == kCompactBatchVersion) {
+    const uint64_t indices_length = r.Varint("compact.indices length");
+    batch.compact.indices = std::string(r.Bytes(indices_length, "compact.indices"));
+    const uint8_t kind = r.Byte("compact value kind");
+    if (r.ok() && kind != kCompactOccupied && kind != kCompactProbabilities) {
+      r.Fail("compact value kind", absl::StrCat("unknown kind ", kind));
+    }
+    const uint64_t values_length = r.Varint("compact values length");
+    // Empty probabilities re-encode as empty bits: refused, so that every record round-trips.
+    if (r.ok() && kind == kCompactProbabilities && values_length == 0) r.Fail("compact values length", "0 probabilities");
+    (kind == kCompactProbabilities ? batch.compact.probabilities : batch.compact.occupied) =
+        std::string(r.Bytes(values_length, "compact values"));
+    // A compact batch of no cells is logged as version 1; encoded so, it would not round-trip.
+    if (r.ok() && batch.compact.empty()) r.Fail("compact.indices", "empty");
+  }
+  const uint64_t key_count = version == kCompactBatchVersion ? 0 : r.Varint("key count");
   // Each key takes at least one byte and its value four: a count beyond that is corruption.
   // (Divided, not multiplied: a count near 2^64 / 5 would wrap round to a small product.)
   if (r.ok() && key_count > r.remaining() / 5) r.Fail("key count", "more than the bytes left");

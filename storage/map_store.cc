@@ -159,6 +159,9 @@ absl::Status MapStoreImpl::Recover() {
     }
     auto batch = DecodeBatch({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1});
     if (!batch.ok()) return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", batch.status().message()));
+    if (absl::Status expanded = ExpandCompact(info_, *batch); !expanded.ok()) {
+      return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", expanded.message()));
+    }
     dedup_.Record(batch->writer_id, batch->sequence,
                   BatchFingerprint({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1}));
     Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}, {}};
@@ -222,11 +225,25 @@ void MapStoreImpl::SplitByShard(Pending& pending) const {
   pending.labels.assign(info_.shards, {});
   const ObservationBatch& b = pending.batch;
   for (const StateLabel& l : b.labels) pending.labels[ShardOf(l.key, info_.shards)].push_back(l);
+  // Bricks spread evenly over the shards: room for a fair share and some, so that a shard's arrays
+  // rarely grow while they fill.
+  const size_t share = b.observation_count() / info_.shards + b.observation_count() / 8 + 16;
+  for (uint32_t s = 0; s < info_.shards; ++s) {
+    keys[s].reserve(share);
+    values[s].reserve(share);
+  }
+  // A coherent scan's neighbouring keys share their brick, so its shard (a hash and a division) is
+  // computed once per run of the brick's keys.
+  uint64_t brick = ~uint64_t{0};
+  uint32_t shard = 0;
   for (size_t i = 0; i < b.keys.size(); ++i) {
     if (!pending.accept[i]) continue;
-    const uint32_t s = ShardOf(b.keys[i], info_.shards);
-    keys[s].push_back(b.keys[i]);
-    values[s].push_back(b.values[i]);
+    if (BrickOf(b.keys[i]) != brick) {
+      brick = BrickOf(b.keys[i]);
+      shard = ShardOf(b.keys[i], info_.shards);
+    }
+    keys[shard].push_back(b.keys[i]);
+    values[shard].push_back(b.values[i]);
   }
   const DensePatch& p = b.patch;
   const GridKeys grid_keys = info_.grid.keys();

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "CLI/CLI.hpp"
+#include "base/compact_scan.h"
 #include "fremen/v1/ingest.grpc.pb.h"
 #include "fremen/v1/maps.grpc.pb.h"
 #include "fremen/v1/query.grpc.pb.h"
@@ -52,6 +53,13 @@ struct Options {
   double seconds = 5;      // per repetition
   int repetitions = 5;
   int predict_calls = 5000;
+  // > 0: each stream sends exactly this many batches, waits for their acknowledgements and the run
+  // ends (no windows, no encoding measurement): a fixed workload whose instructions
+  // scripts/ingest-instructions.sh counts.
+  uint64_t batches = 0;
+  // "cells": CellObservations (x, y, z arrays and floats); "compact": CompactCells (index gaps and
+  // occupied bits).
+  std::string encoding = "cells";
 };
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
@@ -149,13 +157,31 @@ v1::IngestRequest MakeScan(const Options& o, int stream, int k, std::mt19937_64&
   cells.mutable_z()->Reserve(o.cells);
   const uint64_t layer = uint64_t{o.grid} * o.grid;
   const uint64_t first = (static_cast<uint64_t>(stream * kScansPerStream + k) * o.cells) % (layer * o.grid);
+  std::vector<uint64_t> indices;
   for (uint64_t i = first; i < first + o.cells; ++i) {
     const uint64_t c = i % (layer * o.grid);
+    indices.push_back(c);
     cells.add_x(static_cast<uint32_t>(c % o.grid));
     cells.add_y(static_cast<uint32_t>(c / o.grid % o.grid));
     cells.add_z(static_cast<uint32_t>(c / layer));
     request.mutable_cells()->add_values(random() % 4 == 0 ? 1.0f : 0.0f);
   }
+  if (o.encoding != "compact") return request;
+  // The same cells and values, sorted by index (a scan that wraps past the grid's last cell starts
+  // again at 0), in the compact form.
+  std::vector<float> values(request.cells().values().begin(), request.cells().values().end());
+  std::vector<size_t> order(indices.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return indices[a] < indices[b]; });
+  std::vector<uint64_t> sorted_indices;
+  std::vector<float> sorted_values;
+  for (size_t i : order) {
+    sorted_indices.push_back(indices[i]);
+    sorted_values.push_back(values[i]);
+  }
+  v1::CompactCells& compact = *request.mutable_compact();  // clears cells
+  compact.set_indices(fremen::EncodeIndexGaps(sorted_indices));
+  compact.set_occupied(fremen::PackOccupiedBits(sorted_values));
   return request;
 }
 
@@ -175,9 +201,10 @@ void MeasureEncoding(const Options& o) {
   start = Clock::now();
   for (int i = 0; i < kReps; ++i) parsed.ParseFromString(bytes);
   const double decode = Seconds(Clock::now() - start) / kReps;
-  std::printf("one scan of %u cells: %zu bytes (%.1f per cell); encode %.0f µs, decode %.0f µs "
+  std::printf("%s: one scan of %u cells: %zu bytes (%.1f per cell); encode %.0f µs, decode %.0f µs "
               "(%.0fM cells/s to decode on one core)\n",
-              o.cells, bytes.size(), static_cast<double>(bytes.size()) / o.cells, encode * 1e6, decode * 1e6,
+              o.encoding.c_str(), o.cells, bytes.size(), static_cast<double>(bytes.size()) / o.cells, encode * 1e6,
+              decode * 1e6,
               o.cells / decode / 1e6);
 }
 
@@ -198,8 +225,14 @@ class LoadStream {
     reader_ = std::thread([this] { Read(); });
     writer_ = std::thread([this] { Write(); });
   }
-  // Stops writing, waits for the outstanding acknowledgements; the call's status.
-  grpc::Status Stop() {
+  // Stops writing (with `drain`, only once --batches are written), waits for the outstanding
+  // acknowledgements; the call's status.
+  grpc::Status Stop(bool drain = false) {
+    if (drain) {
+      writer_.join();
+      reader_.join();
+      return stream_->Finish();
+    }
     {
       std::lock_guard lock(mutex_);
       stopping_ = true;
@@ -221,7 +254,7 @@ class LoadStream {
 
  private:
   void Write() {
-    for (uint64_t sequence = 0;; ++sequence) {
+    for (uint64_t sequence = 0; o_.batches == 0 || sequence < o_.batches; ++sequence) {
       {
         std::unique_lock lock(mutex_);
         room_.wait(lock, [&] { return stopping_ || in_flight_ < o_.window; });
@@ -276,6 +309,24 @@ class LoadStream {
   std::vector<Clock::time_point> sent_at_;  // by sequence modulo its size (> window)
   std::vector<double> latencies_;
 };
+
+// --batches: every stream sends its fixed number of batches; false when a stream failed.
+bool RunFixed(const Options& o, const Client& client) {
+  std::vector<std::unique_ptr<LoadStream>> streams;
+  for (int s = 0; s < o.streams; ++s) streams.push_back(std::make_unique<LoadStream>(o, client, s));
+  for (auto& s : streams) s->Start();
+  bool ok = true;
+  uint64_t observations = 0;
+  for (auto& s : streams) {
+    const grpc::Status status = s->Stop(/*drain=*/true);
+    ok = ok && status.ok() && !s->failed;
+    if (!status.ok()) std::fprintf(stderr, "stream ended with %d: %s\n", status.error_code(), status.error_message().c_str());
+    observations += s->observations;
+  }
+  std::printf("fixed: %d streams × %lu batches × %u cells: %lu cell-observations acknowledged\n", o.streams,
+              static_cast<unsigned long>(o.batches), o.cells, static_cast<unsigned long>(observations));
+  return ok;
+}
 
 // Runs the streams and prints the figures; false when a stream failed.
 bool RunIngest(const Options& o, const Client& client) {
@@ -376,6 +427,10 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", o.seconds, "seconds per measured window")->capture_default_str();
   app.add_option("--repetitions", o.repetitions, "measured windows (the median is reported)")->capture_default_str()->check(CLI::Range(1, 1000));
   app.add_option("--predict-calls", o.predict_calls, "single-state Predict calls afterwards (0: none)")->capture_default_str();
+  app.add_option("--encoding", o.encoding, "cells (CellObservations) or compact (CompactCells)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"cells", "compact"}));
+  app.add_option("--batches", o.batches, "send exactly this many batches per stream, then stop (a fixed workload; 0: timed windows)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (uint64_t{o.grid} * o.grid * o.grid < o.cells) {
     std::fprintf(stderr, "--cells %u exceeds the grid's %u³ cells\n", o.cells, o.grid);
@@ -384,6 +439,7 @@ int main(int argc, char** argv) {
 
   const Client client(o);
   if (!client.EnsureMap()) return 1;
+  if (o.batches > 0) return RunFixed(o, client) ? 0 : 1;
   MeasureEncoding(o);
   const bool ok = RunIngest(o, client);
   client.Predict();

@@ -1,8 +1,11 @@
 #include "client/lib/scan_builder.h"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "base/compact_scan.h"
 
 namespace fremen::client {
 
@@ -52,6 +55,36 @@ ScanBuilder& ScanBuilder::AddCell(Cell cell, float value) {
   cells->add_values(value);
   ++observations_;
   return *this;
+}
+
+ScanBuilder& ScanBuilder::SetGrid(GridShape grid) {
+  grid_ = grid;
+  return *this;
+}
+
+void ScanBuilder::MaybeCompact() {
+  if (grid_.x == 0 || kind_ != Kind::kCells) return;
+  const v1::CellObservations& cells = request_.cells();
+  if (!AllBinary({cells.values().data(), static_cast<size_t>(cells.values_size())})) return;
+  std::vector<std::pair<uint64_t, float>> indexed(cells.values_size());
+  for (int i = 0; i < cells.values_size(); ++i) {
+    const uint32_t x = cells.cells().x(i), y = cells.cells().y(i), z = cells.cells().z(i);
+    if (x >= grid_.x || y >= grid_.y || z >= grid_.z) return;  // the daemon rejects it by its index
+    indexed[i] = {x + uint64_t{grid_.x} * (y + uint64_t{grid_.y} * z), cells.values(i)};
+  }
+  std::sort(indexed.begin(), indexed.end());
+  std::vector<uint64_t> indices(indexed.size());
+  std::vector<float> values(indexed.size());
+  for (size_t i = 0; i < indexed.size(); ++i) {
+    if (i > 0 && indexed[i].first == indexed[i - 1].first) return;  // a cell twice: only CellObservations
+    indices[i] = indexed[i].first;
+    values[i] = indexed[i].second;
+  }
+  v1::CompactCells compact;
+  compact.set_indices(EncodeIndexGaps(indices));
+  compact.set_occupied(PackOccupiedBits(values));
+  if (compact.ByteSizeLong() >= cells.ByteSizeLong()) return;
+  *request_.mutable_compact() = std::move(compact);
 }
 
 ScanBuilder& ScanBuilder::AddPoint(Point point, float value) {
@@ -133,6 +166,7 @@ absl::StatusOr<Scan> ScanBuilder::Build() {
     } else if (labelled_ && kind_ == Kind::kNamedStates) {
       for (std::string& group : groups_) request_.mutable_named_states()->add_groups(std::move(group));
     }
+    MaybeCompact();
     scan.request = std::move(request_);
     scan.observations = observations_;
   }

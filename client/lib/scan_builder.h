@@ -43,6 +43,13 @@ class ScanBuilder {
   ScanBuilder& AddState(uint64_t id, float value, const std::string& name = "", const std::string& group = "");
   ScanBuilder& AddNamedState(const std::string& name, float value, const std::string& group = "");
 
+  // The map's grid size (GetMap's grid.size). With it, Build sends a scan of cells as CompactCells
+  // (index gaps and one bit a value: about 1.1 bytes a binary observation instead of 7) when that
+  // loses nothing and is smaller: every value 0 or 1, every cell inside `grid` and none twice. The
+  // cells go sorted by index then, so an ack's rejection indices (none, for such a scan, unless
+  // `grid` is not the map's) count in that order. Otherwise, and without a grid, CellObservations.
+  ScanBuilder& SetGrid(GridShape grid);
+
   // Observations added so far.
   uint64_t size() const { return observations_; }
 
@@ -54,11 +61,14 @@ class ScanBuilder {
   enum class Kind { kNone, kCells, kPoints, kPatch, kStates, kNamedStates };
   // Fixes the scan's kind at the first observation; records an error when another kind comes.
   bool Use(Kind kind, const char* what);
+  // The cells as CompactCells in request_, when SetGrid's conditions hold.
+  void MaybeCompact();
 
   v1::IngestRequest request_;
   Kind kind_ = Kind::kNone;
   uint64_t observations_ = 0;
   bool labelled_ = false;  // some AddState/AddNamedState had a name or group
+  GridShape grid_;         // x = 0: no grid set
   std::vector<std::string> names_, groups_;
   absl::Status error_;
 };

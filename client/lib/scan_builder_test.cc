@@ -26,6 +26,32 @@ TEST(ScanBuilderTest, CellsBecomeParallelArrays) {
   EXPECT_THAT(cells.values(), ElementsAre(1.0f, 0.25f));
 }
 
+TEST(ScanBuilderTest, WithTheGridABinaryCellScanGoesCompactSortedByIndex) {
+  ScanBuilder builder(1.7e9);
+  builder.SetGrid({10, 10, 2});
+  for (uint32_t x = 9; x > 0; --x) builder.AddCell({x, 3, 1}, x % 2 ? 1.0f : 0.0f);
+  auto scan = builder.Build();
+  ASSERT_TRUE(scan.ok()) << scan.status();
+  ASSERT_TRUE(scan->request.has_compact());
+  EXPECT_EQ(scan->observations, 9u);
+  // Index 131 (x 1, y 3, z 1) first, then gaps of 1; x odd = 1: bits 1, 0, 1, ... from x = 1.
+  EXPECT_EQ(scan->request.compact().indices(), std::string("\x83\x01") + std::string(8, '\x01'));
+  EXPECT_EQ(scan->request.compact().occupied(), std::string("\x55\x01", 2));
+  // The grid stays for the next scan.
+  builder.AddCell({0, 0, 0}, 1).AddCell({1, 0, 0}, 0);
+  EXPECT_TRUE(builder.Build()->request.has_compact());
+}
+
+TEST(ScanBuilderTest, SoftValuesCellsOutsideTheGridOrTwiceStayCellObservations) {
+  ScanBuilder builder(1.7e9);
+  builder.SetGrid({10, 10, 1});
+  EXPECT_TRUE(builder.AddCell({1, 1, 0}, 0.5f).AddCell({2, 1, 0}, 1).Build()->request.has_cells());
+  EXPECT_TRUE(builder.AddCell({10, 1, 0}, 1).AddCell({2, 1, 0}, 1).Build()->request.has_cells());
+  EXPECT_TRUE(builder.AddCell({2, 1, 0}, 1).AddCell({2, 1, 0}, 0).Build()->request.has_cells());
+  ScanBuilder no_grid(1.7e9);
+  EXPECT_TRUE(no_grid.AddCell({1, 1, 0}, 1).AddCell({2, 1, 0}, 1).Build()->request.has_cells());
+}
+
 TEST(ScanBuilderTest, PointsBecomeParallelArrays) {
   ScanBuilder builder(10);
   builder.AddPoint({0.5, 1.5, 0}, 1);

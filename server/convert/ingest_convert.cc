@@ -87,6 +87,7 @@ absl::Status FromCells(const MapInfo& map, const v1::CellObservations& cells, Ob
   const auto fill = flat ? (z.empty() ? CellKeys<true, false> : CellKeys<true, true>)
                          : (z.empty() ? CellKeys<false, false> : CellKeys<false, true>);
   fill(map.grid, x.data(), y.data(), z.data(), n, batch.keys.data());
+  batch.keys_from_grid.set = true;
   CopyValues(cells.values(), batch);
   return absl::OkStatus();
 }
@@ -107,6 +108,7 @@ absl::Status FromPoints(const MapInfo& map, const v1::PointObservations& points,
     const auto cell = map.grid.CellOf(x[i], y[i], z.empty() ? 0.0 : z[i]);
     batch.keys[i] = cell ? keys.Key((*cell)[0], (*cell)[1], (*cell)[2]) : kOutsideMapKey;
   }
+  batch.keys_from_grid.set = true;
   CopyValues(points.values(), batch);
   return absl::OkStatus();
 }
@@ -188,6 +190,14 @@ absl::Status FromPatch(const v1::DensePatch& patch, ObservationBatch& batch) {
   return absl::OkStatus();
 }
 
+// The bytes as they came (the log keeps them), then their expansion into keys and values.
+absl::Status FromCompact(const MapInfo& map, const v1::CompactCells& compact, ObservationBatch& batch) {
+  batch.compact.indices = compact.indices();
+  batch.compact.occupied = compact.occupied();
+  batch.compact.probabilities = compact.probabilities();
+  return storage::ExpandCompact(map, batch);
+}
+
 absl::Status FillObservations(const MapInfo& map, const v1::IngestRequest& request, ObservationBatch& batch) {
   switch (request.observations_case()) {
     case v1::IngestRequest::kCells:
@@ -199,6 +209,9 @@ absl::Status FillObservations(const MapInfo& map, const v1::IngestRequest& reque
     case v1::IngestRequest::kPatch:
       if (auto s = CheckKind(map, "patch observations", MapKind::kGrid); !s.ok()) return s;
       return FromPatch(request.patch(), batch);
+    case v1::IngestRequest::kCompact:
+      if (auto s = CheckKind(map, "compact cells", MapKind::kGrid); !s.ok()) return s;
+      return FromCompact(map, request.compact(), batch);
     case v1::IngestRequest::kStates:
       if (auto s = CheckKind(map, "states by id", MapKind::kGeneric); !s.ok()) return s;
       return FromStates(request.states(), batch);
@@ -208,7 +221,7 @@ absl::Status FillObservations(const MapInfo& map, const v1::IngestRequest& reque
     case v1::IngestRequest::OBSERVATIONS_NOT_SET:
       break;
   }
-  return Invalid("observations are required: one of cells, points, states, named_states or patch");
+  return Invalid("observations are required: one of cells, points, states, named_states, patch or compact");
 }
 
 v1::RejectReason ReasonToProto(storage::RejectReason reason) {

@@ -23,8 +23,8 @@
 namespace fremen::server {
 
 // No cell has this key (3-D Morton keys use 63 bits, 2-D ones 42), so the store rejects it as
-// outside the map.
-inline constexpr uint64_t kOutsideMapKey = ~uint64_t{0};
+// outside the map: storage's own key for that.
+inline constexpr uint64_t kOutsideMapKey = storage::kNotACellKey;
 
 // The batch `request` describes for `map`; InvalidArgument naming the field when it is unusable as
 // a whole.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "base/compact_scan.h"
 #include "storage/state_names.h"
 
 namespace fremen::server {
@@ -68,6 +69,33 @@ TEST(IngestConvertTest, CellsBecomeGridKeys) {
   EXPECT_THAT(batch->keys, ElementsAre(keys.Key(1, 2, 3), keys.Key(9, 9, 0)));
   EXPECT_THAT(batch->values, ElementsAre(1.0f, 0.25f));
   EXPECT_TRUE(storage::ValidateBatch(map, *batch).ok());
+}
+
+TEST(IngestConvertTest, CompactCellsBecomeTheKeysAndValuesOfTheSameCellsByIndex) {
+  const storage::MapInfo map = Grid(10, 10, 4);
+  v1::IngestRequest by_index = Request();
+  v1::IngestRequest compact = Request();
+  std::vector<uint64_t> indices;
+  std::vector<float> values;
+  for (uint32_t i = 5; i < 400; i += 1 + i % 3) {
+    AddCell(by_index, i % 10, i / 10 % 10, i / 100, static_cast<float>(i % 2));
+    indices.push_back(i);
+    values.push_back(static_cast<float>(i % 2));
+  }
+  compact.mutable_compact()->set_indices(EncodeIndexGaps(indices));
+  compact.mutable_compact()->set_occupied(PackOccupiedBits(values));
+  auto want = BatchFromRequest(map, by_index);
+  auto got = BatchFromRequest(map, compact);
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->keys, want->keys);
+  EXPECT_EQ(got->values, want->values);
+  // The log keeps the bytes as they came.
+  EXPECT_EQ(got->compact.indices, compact.compact().indices());
+  EXPECT_EQ(got->compact.occupied, compact.compact().occupied());
+  EXPECT_TRUE(storage::ValidateBatch(map, *got).ok());
+  compact.mutable_compact()->set_occupied("");
+  EXPECT_THAT(ErrorOf(map, compact), HasSubstr("compact: one of occupied or probabilities is required"));
+  EXPECT_THAT(ErrorOf(Generic(), compact), HasSubstr("compact cells are only for grid maps"));
 }
 
 TEST(IngestConvertTest, CellsWithoutZAreInTheFirstLayer) {

@@ -57,6 +57,44 @@ class IngestTest(DaemonTestCase):
             acks = session.wait()
         self.assertEqual([a.accepted for a in acks], [12, 48])
 
+    def test_compact_cells_give_the_models_of_the_same_cells_sent_by_index(self):
+        # An 8×6×2 grid: linear index x + 8·(y + 6·z).
+        for name in ("by_index", "compact"):
+            self.client.create_map(name, size=(8, 6, 2), resolution=0.5)
+        indices = [i for i in range(96) if i % 3 != 1]
+        occupied = [i % 2 for i in indices]
+        cells = [(i % 8, i // 8 % 6, i // 48) for i in indices]
+        with self.client.ingest("by_index") as session:
+            session.send(T, occupied, cells=cells)
+            session.send(T + 60, [1 - v for v in occupied], cells=cells)
+            session.wait()
+        with self.client.ingest("compact") as session:
+            session.send_compact(T, indices, occupied=occupied)
+            session.send_compact(T + 60, indices, probabilities=bytes(255 * (1 - v) for v in occupied))
+            acks = session.wait()
+        self.assertEqual([(a.accepted, a.rejected, a.ok) for a in acks], [(64, 0, True), (64, 0, True)])
+        # The same observations give the same models: the same predictions, exactly.
+        times = [T + 3600 * h for h in range(5)]
+        compact_p = self.client.predict("compact", times, cells=cells)
+        by_index_p = self.client.predict("by_index", times, cells=cells)
+        self.assertEqual(compact_p.unobserved, [])
+        self.assertEqual(repr(compact_p.probabilities), repr(by_index_p.probabilities))
+
+    def test_malformed_compact_cells_are_refused_before_sending_or_by_the_daemon_naming_the_field(self):
+        self.client.create_map("lab", size=(8, 6), resolution=0.5)
+        with self.client.ingest("lab") as session:
+            with self.assertRaises(fremen.InvalidArgument):
+                session.send_compact(T, [3, 2], occupied=[1, 1])
+            with self.assertRaises(fremen.InvalidArgument):
+                session.send_compact(T, [1, 2], occupied=[0.5, 1])
+            session.send_compact(T, [1, 2], probabilities=b"a")
+            session.send_compact(T, [47, 48, 1000], occupied=[1, 0, 1])
+            bad, outside = session.wait()
+        self.assertIsInstance(bad.error, fremen.InvalidArgument)
+        self.assertIn("compact.probabilities has 1 bytes for 2 cells", str(bad.error))
+        self.assertEqual((outside.accepted, outside.rejected), (1, 2))
+        self.assertEqual(outside.rejections, [fremen.Rejection(1, "outside_map"), fremen.Rejection(2, "outside_map")])
+
     def test_a_batch_refused_as_a_whole_carries_its_error_and_the_stream_goes_on(self):
         self.client.create_map("doors")
         with self.client.ingest("doors") as session:

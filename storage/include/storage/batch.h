@@ -15,6 +15,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "storage/compact_cells.h"
 #include "storage/map_info.h"
 
 namespace fremen::storage {
@@ -41,6 +42,18 @@ struct ObservationBatch {
   double time = 0;
   std::vector<uint64_t> keys;
   std::vector<float> values;  // one per key
+  // Cells in the API's compact form, when they came so: keys and values are then its expansion
+  // (ExpandCompact), and the log keeps this form instead of them.
+  CompactCells compact;
+  // Set by what made the keys from cell indices (the API's conversions, ExpandCompact): every key
+  // is a cell's inside the grid or kNotACellKey, so that Classify need not decode each key to
+  // check it (a tenth of the ingest path's instructions). Not content: neither logged nor compared;
+  // a batch decoded from a version 1 record has it unset and is checked key by key, to the same
+  // result.
+  struct KeysFromGrid {
+    bool set = false;
+    bool operator==(const KeysFromGrid&) const { return true; }
+  } keys_from_grid;
   DensePatch patch;           // empty when size has a zero
   std::vector<StateLabel> labels;
 
@@ -92,7 +105,14 @@ absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch);
 // Marks each observation accepted or rejected; `accept[i]` for i over keys then patch cells.
 BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector<uint8_t>& accept);
 
-// Log payload encoding. Decode answers DataLoss on damaged bytes.
+// Fills keys and values from a non-empty batch.compact (a grid map only); InvalidArgument naming
+// the field (compact.indices, ...) when it is malformed. OK and nothing done when compact is empty.
+absl::Status ExpandCompact(const MapInfo& map, ObservationBatch& batch);
+
+// Log payload encoding: version 2 when batch.compact is set (its bytes as they came, not keys and
+// values), version 1 otherwise, so that a batch of the other kinds keeps its bytes and fingerprint.
+// DecodeBatch reads both; a version 2 batch comes back with compact set and keys empty, for
+// ExpandCompact. Decode answers DataLoss on damaged bytes.
 std::string EncodeBatch(const ObservationBatch& batch);
 absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes);
 
