@@ -161,13 +161,13 @@ absl::Status MapStoreImpl::Recover() {
     if (!batch.ok()) return absl::DataLossError(absl::StrCat("log record ", lsn, ": ", batch.status().message()));
     dedup_.Record(batch->writer_id, batch->sequence,
                   BatchFingerprint({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1}));
-    Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}, {}};
+    Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}, {}, {}, {}};
     pending.ack = Classify(info_, pending.batch, pending.accept);
     SplitByShard(pending);
     const ScanContext scan(settings_->periods, pending.batch.time);
     for (uint32_t s = 0; s < shards_.size(); ++s) {
       if (shards_[s]->checkpoint_lsn() >= lsn) continue;  // the checkpoint has it already
-      shards_[s]->Apply(scan, pending.keys[s], pending.values[s]);
+      ApplyToShard(s, pending, scan);
       shards_[s]->ApplyLabels(pending.labels[s]);
     }
     return absl::OkStatus();
@@ -205,7 +205,7 @@ absl::Status MapStoreImpl::Recover() {
 }
 
 MapStoreImpl::Pending MapStoreImpl::Prepare(ObservationBatch batch, AckCallback done) const {
-  Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}, {}};
+  Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}, {}, {}, {}};
   pending.ack = Classify(info_, pending.batch, pending.accept);
   pending.record.push_back(kBatchRecord);
   pending.record += EncodeBatch(pending.batch);
@@ -222,9 +222,27 @@ void MapStoreImpl::SplitByShard(Pending& pending) const {
   pending.labels.assign(info_.shards, {});
   const ObservationBatch& b = pending.batch;
   for (const StateLabel& l : b.labels) pending.labels[ShardOf(l.key, info_.shards)].push_back(l);
+  // A history's runs: the batch's observations split where the time changes (rejected ones
+  // included, as in the scans the history stands for), each shard's part of a run one run of it.
+  std::vector<uint64_t> last_run;  // by shard, the batch run its last run is part of, +1
+  uint64_t run = 0;
+  if (b.is_history()) {
+    pending.runs.assign(info_.shards, {});
+    last_run.assign(info_.shards, 0);
+  }
   for (size_t i = 0; i < b.keys.size(); ++i) {
+    if (b.is_history() && i > 0 && b.times[i] != b.times[i - 1]) ++run;
     if (!pending.accept[i]) continue;
     const uint32_t s = ShardOf(b.keys[i], info_.shards);
+    if (b.is_history()) {
+      const uint32_t end = static_cast<uint32_t>(keys[s].size()) + 1;
+      if (last_run[s] == run + 1) {
+        pending.runs[s].back().end = end;
+      } else {
+        pending.runs[s].push_back({b.times[i], end});
+        last_run[s] = run + 1;
+      }
+    }
     keys[s].push_back(b.keys[i]);
     values[s].push_back(b.values[i]);
   }
@@ -246,9 +264,17 @@ void MapStoreImpl::SplitByShard(Pending& pending) const {
 
 absl::Status MapStoreImpl::Submit(ObservationBatch batch, AckCallback done) {
   if (absl::Status valid = ValidateBatch(info_, batch); !valid.ok()) return valid;
-  if (info_.lossless_sampling_period > 0 && batch.time < info_.lossless_origin) {
+  if (info_.lossless_sampling_period > 0 && batch.time < info_.lossless_origin && !batch.is_history()) {
     return absl::InvalidArgumentError(absl::StrCat("time must not be before the map's lossless origin ",
                                                    info_.lossless_origin, ", got ", batch.time));
+  }
+  if (info_.lossless_sampling_period > 0) {
+    for (size_t i = 0; i < batch.times.size(); ++i) {
+      if (batch.times[i] < info_.lossless_origin) {
+        return absl::InvalidArgumentError(absl::StrCat("times[", i, "] must not be before the map's lossless origin ",
+                                                       info_.lossless_origin, ", got ", batch.times[i]));
+      }
+    }
   }
   const uint64_t n = batch.observation_count();
   const auto refusal = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(queue_mutex_) -> absl::Status {
@@ -549,6 +575,21 @@ void MapStoreImpl::ApplyLoop() {
   }
 }
 
+void MapStoreImpl::ApplyToShard(uint32_t s, const Pending& pending, const ScanContext& scan) const {
+  const std::span<const uint64_t> keys = pending.keys[s];
+  const std::span<const float> values = pending.values[s];
+  if (pending.runs.empty()) {
+    shards_[s]->Apply(scan, keys, values);
+    return;
+  }
+  uint32_t begin = 0;
+  for (const Pending::Run& run : pending.runs[s]) {
+    shards_[s]->Apply(ScanContext(settings_->periods, run.time), keys.subspan(begin, run.end - begin),
+                      values.subspan(begin, run.end - begin));
+    begin = run.end;
+  }
+}
+
 void MapStoreImpl::ApplyGroup(std::vector<Pending>& group) {
   // Every shard folds in its part of every batch, in batch order.
   std::vector<const Pending*> fresh;
@@ -561,7 +602,7 @@ void MapStoreImpl::ApplyGroup(std::vector<Pending>& group) {
   if (!fresh.empty()) {
     workers_->RunOnAll([&](uint32_t s) {
       for (size_t b = 0; b < fresh.size(); ++b) {
-        shards_[s]->Apply(scans[b], fresh[b]->keys[s], fresh[b]->values[s]);
+        ApplyToShard(s, *fresh[b], scans[b]);
         if (!fresh[b]->labels[s].empty()) shards_[s]->ApplyLabels(fresh[b]->labels[s]);
       }
     });

@@ -3,9 +3,11 @@
 #include <array>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "storage/model/observation.h"
 #include "storage/state_names.h"
 
 namespace fremen::server {
@@ -152,6 +154,66 @@ absl::Status FromNamedStates(const v1::NamedStateObservations& named, Observatio
   return absl::OkStatus();
 }
 
+// One state's history (a single id) or many states' (an id per value), each observation with its
+// own time; the request's time must stay unset. The times are checked here so that the message
+// names history.times rather than the store's times.
+absl::Status FromHistory(const v1::IngestRequest& request, ObservationBatch& batch) {
+  const v1::HistoryObservations& history = request.history();
+  const size_t n = history.values_size();
+  if (request.time() != 0) {
+    return Invalid(absl::StrCat("time must be 0 (unset) with history, whose observations carry their own times "
+                                "(history.times); got ",
+                                request.time()));
+  }
+  if (auto s = CheckLength("history.times", history.times_size(), "times", n, "values"); !s.ok()) return s;
+  // The states: by ids, which names and groups label, or, without ids, by names, as named_states.
+  const bool by_name = history.ids_size() == 0 && history.names_size() > 0;
+  const size_t ids = by_name ? history.names_size() : history.ids_size();
+  const absl::string_view id_field = by_name ? "history.names" : "history.ids";
+  if (ids != 1) {
+    if (auto s = CheckLength(id_field, ids, by_name ? "names" : "ids", n, "values (or exactly 1: one state's history)");
+        !s.ok()) {
+      return s;
+    }
+  }
+  if (!by_name) {
+    if (auto s = CheckOptionalLength("history.names", history.names_size(), "names", ids, "ids"); !s.ok()) return s;
+  }
+  if (auto s = CheckOptionalLength("history.groups", history.groups_size(), "groups", ids, by_name ? "names" : "ids");
+      !s.ok()) {
+    return s;
+  }
+  const double* times = history.times().data();
+  for (size_t i = 0; i < n; ++i) {
+    if (!(times[i] >= 0.0 && times[i] <= model::kMaxAbsTime)) {
+      return storage::CheckTime(times[i], absl::StrCat("history.times[", i, "]"));
+    }
+  }
+  batch.times.assign(history.times().begin(), history.times().end());
+  std::vector<uint64_t> keys(ids);
+  for (size_t i = 0; i < ids; ++i) {
+    if (by_name && history.names(i).empty()) {
+      return Invalid(absl::StrCat("history.names[", i, "] is empty; every state needs a name"));
+    }
+    keys[i] = by_name ? storage::StateIdOfName(history.names(i)) : history.ids(i);
+  }
+  if (ids == 1) {
+    batch.keys.assign(n, keys[0]);
+  } else {
+    batch.keys = std::move(keys);
+  }
+  CopyValues(history.values(), batch);
+  for (int i = 0; i < history.names_size() || i < history.groups_size(); ++i) {
+    const std::string& name = history.names_size() > 0 ? history.names(i) : NoLabel();
+    const std::string& group = history.groups_size() > 0 ? history.groups(i) : NoLabel();
+    if (name.empty() && group.empty()) continue;
+    if (auto s = CheckLabel("history.names", i, name); !s.ok()) return s;
+    if (auto s = CheckLabel("history.groups", i, group); !s.ok()) return s;
+    batch.labels.push_back({ids == 1 ? batch.keys[0] : batch.keys[i], name, group});
+  }
+  return absl::OkStatus();
+}
+
 // x·y·z, saturated: a patch of 2^32 cells along each axis must not wrap around to a small count.
 uint64_t CellCount(const std::array<uint32_t, 3>& size) {
   uint64_t count = 1;
@@ -205,10 +267,13 @@ absl::Status FillObservations(const MapInfo& map, const v1::IngestRequest& reque
     case v1::IngestRequest::kNamedStates:
       if (auto s = CheckKind(map, "named_states", MapKind::kGeneric); !s.ok()) return s;
       return FromNamedStates(request.named_states(), batch);
+    case v1::IngestRequest::kHistory:
+      if (auto s = CheckKind(map, "history observations", MapKind::kGeneric); !s.ok()) return s;
+      return FromHistory(request, batch);
     case v1::IngestRequest::OBSERVATIONS_NOT_SET:
       break;
   }
-  return Invalid("observations are required: one of cells, points, states, named_states or patch");
+  return Invalid("observations are required: one of cells, points, states, named_states, patch or history");
 }
 
 v1::RejectReason ReasonToProto(storage::RejectReason reason) {

@@ -1,5 +1,5 @@
-// A batch of observations: one time, many states (one robot scan), from one writer with a sequence
-// number. The unit of the write path: validated, logged, applied and acknowledged whole.
+// A batch of observations: one time, many states (one robot scan), or a history (a time per
+// observation: a robot's log, an imported dataset), from one writer with a sequence number. The unit of the write path: validated, logged, applied and acknowledged whole.
 //
 // States are given by key (storage/cell_key.h: Morton code of a grid cell, or a generic state's id)
 // or, for grids, as a dense patch (a box of cells, values x fastest, then y, then z). Generic states
@@ -43,6 +43,11 @@ struct ObservationBatch {
   std::vector<float> values;  // one per key
   DensePatch patch;           // empty when size has a zero
   std::vector<StateLabel> labels;
+  // A history: empty for a scan (every observation at `time`), else one time per key, `time` 0 and
+  // no patch. Applied as one scan per run of consecutive keys with the same time, in order.
+  std::vector<double> times;
+
+  bool is_history() const { return !times.empty(); }
 
   size_t observation_count() const {
     return keys.size() + size_t{patch.size[0]} * patch.size[1] * patch.size[2];
@@ -86,13 +91,15 @@ inline constexpr size_t kMaxLabelLength = 256;
 absl::Status CheckTime(double t, absl::string_view field);
 
 // Checks what makes the whole batch unusable (the message names the field): the time (CheckTime), mismatched lengths, a patch outside the grid or with the wrong value count,
-// labels on a grid. Per-observation problems are not errors: see Classify.
+// labels on a grid; for a history also every time (CheckTime, "times[i]"), a time or a patch beside
+// the times, and a grid map (histories are for generic maps). Per-observation problems are not errors: see Classify.
 absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch);
 
 // Marks each observation accepted or rejected; `accept[i]` for i over keys then patch cells.
 BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector<uint8_t>& accept);
 
-// Log payload encoding. Decode answers DataLoss on damaged bytes.
+// Log payload encoding. Decode answers DataLoss on damaged bytes. A scan is written as version 1
+// (unchanged, so that fingerprints of scans stay as they were), a history as version 2; both read.
 std::string EncodeBatch(const ObservationBatch& batch);
 absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes);
 
