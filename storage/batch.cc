@@ -125,11 +125,13 @@ void PutTimes(std::string* out, const std::vector<double>& times) {
   const size_t at = out->size();
   out->resize(at + times.size() * model::kMaxVarint64Bytes);
   char* end = out->data() + at;
-  uint64_t previous = 0;
+  uint64_t previous = 0, previous_delta = 0;
   for (double t : times) {
     const uint64_t bits = BitsOf(t);
-    end = model::EncodeVarint64(end, model::ZigZagEncode64(static_cast<int64_t>(bits - previous)));
+    const uint64_t delta = bits - previous;  // wraps: exact in modular arithmetic
+    end = model::EncodeVarint64(end, model::ZigZagEncode64(static_cast<int64_t>(delta - previous_delta)));
     previous = bits;
+    previous_delta = delta;
   }
   out->resize(end - out->data());
 }
@@ -139,10 +141,11 @@ void PutTimes(std::string* out, const std::vector<double>& times) {
 // key count varint | keys (delta-zigzag varints: scans are spatially sorted, so deltas are small) |
 // values f32 each | patch origin 3×varint | patch size 3×varint | patch values f32 each |
 // label count varint | labels (key varint, name, group as length-prefixed bytes).
-// Version 2, a history: the same, then one time per key, each as the zigzag varint of the
-// difference of its IEEE-754 bits from the previous time's (the first from 0): exact for any
-// doubles, and a log in time order with times of the same magnitude takes 3-5 bytes a time instead
-// of 8 (one state's history's keys, all the same, take a byte each).
+// Version 2, a history: the same, then one time per key, as the zigzag varints of the second
+// differences of the times' IEEE-754 bits (integer arithmetic modulo 2^64, starting from 0): exact
+// for any doubles, and a log sampled at a steady rate (a minute apart: the bits of times of one
+// binade step by the same integer) takes a byte a time instead of 8; an irregular one 4-5 bytes.
+// One state's history's keys, all the same, take a byte each.
 std::string EncodeBatch(const ObservationBatch& batch) {
   std::string out;
   out.reserve(32 + (batch.keys.size() + batch.times.size()) * model::kMaxVarint64Bytes +
@@ -230,9 +233,10 @@ absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes) {
     if (batch.keys.empty()) r.Fail("times", "a history without observations");
     if (r.ok() && batch.keys.size() > r.remaining()) r.Fail("times", "more than the bytes left");
     batch.times.resize(r.ok() ? batch.keys.size() : 0);
-    uint64_t previous = 0;
+    uint64_t previous = 0, delta = 0;
     for (double& t : batch.times) {
-      previous += static_cast<uint64_t>(model::ZigZagDecode64(r.Varint("time")));
+      delta += static_cast<uint64_t>(model::ZigZagDecode64(r.Varint("time")));
+      previous += delta;
       t = std::bit_cast<double>(previous);
     }
   }

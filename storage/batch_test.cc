@@ -168,12 +168,13 @@ TEST(BatchTest, ScansStayVersion1SoTheirFingerprintsDoNotChange) {
   EXPECT_TRUE(decoded->times.empty());
 }
 
-TEST(BatchTest, OneStatesHistoryInTimeOrderTakesAboutNineBytesAnObservation) {
-  const ObservationBatch batch = History(96'000);
+TEST(BatchTest, OneStatesHistoryAMinuteApartTakesSixBytesAnObservation) {
+  ObservationBatch batch = History(96'000);
+  batch.times[3] = batch.times[2] + 60;  // steady throughout
   const std::string bytes = EncodeBatch(batch);
-  // A key byte (delta 0), a float, and the time's bit delta (60 s at 1.7e9: about 2^28 ulps, 4
-  // bytes) instead of 8 bytes of double.
-  EXPECT_LE(bytes.size(), 9 * batch.keys.size() + 64) << bytes.size();
+  // A key byte (delta 0), a float, and the time's second difference (0 at a steady rate, a byte)
+  // instead of 8 bytes of double; the time's step changes at 2^31 s (a new binade): a few bytes.
+  EXPECT_LE(bytes.size(), 6 * batch.keys.size() + 64) << bytes.size();
 }
 
 TEST(BatchTest, HistoryProblemsNameTheField) {

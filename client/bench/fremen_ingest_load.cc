@@ -117,8 +117,7 @@ bool Client::EnsureMap() const {
   grpc::Status status = maps_->GetMap(Context().get(), get, &got);
   const v1::MapKind kind = o_.history_states > 0 ? v1::MAP_KIND_GENERIC : v1::MAP_KIND_GRID;
   if (status.ok() && got.map().kind() != kind) {
-    std::fprintf(stderr, "map %s is not a %s map; choose another --map
-", o_.map.c_str(),
+    std::fprintf(stderr, "map %s is not a %s map; choose another --map\n", o_.map.c_str(),
                  kind == v1::MAP_KIND_GRID ? "grid" : "generic");
     return false;
   }
