@@ -47,6 +47,24 @@ absl::Status CheckLabel(absl::string_view field, int i, const std::string& text)
   return Invalid(absl::StrCat(field, "[", i, "] has ", text.size(), " bytes; at most ", storage::kMaxLabelLength, " allowed"));
 }
 
+// The labels of a message whose names and groups are each empty or one per state (lengths checked
+// already): label i, unless both are empty, is of state key_of(i). `message` ("states",
+// "history") names the fields in errors.
+template <typename KeyOf>
+absl::Status AddLabels(absl::string_view message, const google::protobuf::RepeatedPtrField<std::string>& names,
+                       const google::protobuf::RepeatedPtrField<std::string>& groups, KeyOf key_of,
+                       ObservationBatch& batch) {
+  for (int i = 0; i < names.size() || i < groups.size(); ++i) {
+    const std::string& name = names.empty() ? NoLabel() : names[i];
+    const std::string& group = groups.empty() ? NoLabel() : groups[i];
+    if (name.empty() && group.empty()) continue;
+    if (auto s = CheckLabel(absl::StrCat(message, ".names"), i, name); !s.ok()) return s;
+    if (auto s = CheckLabel(absl::StrCat(message, ".groups"), i, group); !s.ok()) return s;
+    batch.labels.push_back({key_of(i), name, group});
+  }
+  return absl::OkStatus();
+}
+
 absl::Status CheckKind(const MapInfo& map, absl::string_view what, MapKind wanted) {
   if (map.kind == wanted) return absl::OkStatus();
   return Invalid(absl::StrCat(what, " ", wanted == MapKind::kGrid ? "are only for grid maps" : "are only for generic maps",
@@ -120,15 +138,7 @@ absl::Status FromStates(const v1::StateObservations& states, ObservationBatch& b
   if (auto s = CheckOptionalLength("states.groups", states.groups_size(), "groups", n, "ids"); !s.ok()) return s;
   batch.keys.assign(states.ids().begin(), states.ids().end());
   CopyValues(states.values(), batch);
-  for (int i = 0; i < states.names_size() || i < states.groups_size(); ++i) {
-    const std::string& name = states.names_size() > 0 ? states.names(i) : NoLabel();
-    const std::string& group = states.groups_size() > 0 ? states.groups(i) : NoLabel();
-    if (name.empty() && group.empty()) continue;
-    if (auto s = CheckLabel("states.names", i, name); !s.ok()) return s;
-    if (auto s = CheckLabel("states.groups", i, group); !s.ok()) return s;
-    batch.labels.push_back({states.ids(i), name, group});
-  }
-  return absl::OkStatus();
+  return AddLabels("states", states.names(), states.groups(), [&](int i) { return states.ids(i); }, batch);
 }
 
 absl::Status FromNamedStates(const v1::NamedStateObservations& named, ObservationBatch& batch) {
@@ -203,15 +213,8 @@ absl::Status FromHistory(const v1::IngestRequest& request, ObservationBatch& bat
     batch.keys = std::move(keys);
   }
   CopyValues(history.values(), batch);
-  for (int i = 0; i < history.names_size() || i < history.groups_size(); ++i) {
-    const std::string& name = history.names_size() > 0 ? history.names(i) : NoLabel();
-    const std::string& group = history.groups_size() > 0 ? history.groups(i) : NoLabel();
-    if (name.empty() && group.empty()) continue;
-    if (auto s = CheckLabel("history.names", i, name); !s.ok()) return s;
-    if (auto s = CheckLabel("history.groups", i, group); !s.ok()) return s;
-    batch.labels.push_back({ids == 1 ? batch.keys[0] : batch.keys[i], name, group});
-  }
-  return absl::OkStatus();
+  return AddLabels("history", history.names(), history.groups(),
+                   [&](int i) { return ids == 1 ? batch.keys[0] : batch.keys[i]; }, batch);
 }
 
 // x·y·z, saturated: a patch of 2^32 cells along each axis must not wrap around to a small count.
