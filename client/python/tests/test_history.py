@@ -11,8 +11,9 @@ T = 1.7e9
 
 
 def door_log(n):
-    """n minutes of a door: open for stretches."""
-    return [T + 60.0 * i for i in range(n)], [1.0 if (i // 37) % 3 == 0 else 0.0 for i in range(n)]
+    """n minutes of a door open by day (08:00-18:00)."""
+    times = [T + 60.0 * i for i in range(n)]
+    return times, [1.0 if 8 <= (t % 86400) / 3600 < 18 else 0.0 for t in times]
 
 
 def _flat(array):
@@ -26,11 +27,11 @@ class HistoryTest(DaemonTestCase):
     def test_a_history_predicts_as_one_scan_per_time(self):
         self.client.create_map("by_history")
         self.client.create_map("by_scans")
-        times, values = door_log(3000)
+        times, values = door_log(3 * 1440)
         with self.client.ingest("by_history") as session:
             session.send_history(times, values, names=["door"])
             (ack,) = session.wait()
-        self.assertEqual((ack.accepted, ack.rejected, ack.ok), (3000, 0, True))
+        self.assertEqual((ack.accepted, ack.rejected, ack.ok), (3 * 1440, 0, True))
         with self.client.ingest("by_scans") as session:
             for t, v in zip(times, values):
                 session.send(t, [v], names=["door"])
@@ -38,11 +39,12 @@ class HistoryTest(DaemonTestCase):
         for name in ("by_history", "by_scans"):
             self.client.update(name)
         query_times = [T + 3600.0 * h + 7 for h in range(0, 100, 3)]
-        by_history = self.client.predict("by_history", query_times, names=["door"]).probabilities
-        by_scans = self.client.predict("by_scans", query_times, names=["door"]).probabilities
+        # At order 2 (the first update selects on no evidence yet), so that P is periodic.
+        by_history = self.client.predict("by_history", query_times, names=["door"], order=2).probabilities
+        by_scans = self.client.predict("by_scans", query_times, names=["door"], order=2).probabilities
         self.assertEqual([float(p) for p in _flat(by_history)], [float(p) for p in _flat(by_scans)])
         self.assertGreater(len(set(float(p) for p in _flat(by_history))), 1, "P was not published")
-        self.assertEqual(self.client.stats("by_history").observations, 3000)
+        self.assertEqual(self.client.stats("by_history").observations, 3 * 1440)
 
     def test_many_states_by_id_each_with_its_time(self):
         self.client.create_map("doors")
