@@ -2,6 +2,7 @@
 
 #include <xxhash.h>
 
+#include <bit>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -12,13 +13,36 @@
 namespace fremen::storage {
 
 namespace {
-constexpr uint8_t kBatchVersion = 1;
+constexpr uint8_t kBatchVersion = 1;         // a scan
 constexpr uint8_t kCompactBatchVersion = 2;  // compact cells instead of keys and values
+constexpr uint8_t kHistoryVersion = 3;       // a history: version 1's fields, then the times
 constexpr uint8_t kCompactOccupied = 0, kCompactProbabilities = 1;
 // A batch is one message of at most a few hundred MB; more observations than this is corruption.
 constexpr uint64_t kMaxBatchObservations = 1ull << 28;
 
 bool ValueOk(float v) { return v >= 0.0f && v <= 1.0f; }  // false for NaN
+}  // namespace
+
+namespace {
+absl::Status ValidateHistory(const MapInfo& map, const ObservationBatch& batch) {
+  if (map.kind != MapKind::kGeneric) return absl::InvalidArgumentError("a history (times) is only for generic maps");
+  if (batch.time != 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "time must be 0 for a history, whose observations carry their own times; got ", batch.time));
+  }
+  if (batch.times.size() != batch.keys.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("times must hold one time per state: ", batch.times.size(),
+                                                   " times for ", batch.keys.size(), " states"));
+  }
+  if (batch.patch.values.size() > 0) return absl::InvalidArgumentError("a history has no patch");
+  for (size_t i = 0; i < batch.times.size(); ++i) {
+    // The loop's common case is one comparison pair; the message is built only for a bad time.
+    if (!(batch.times[i] >= 0.0 && batch.times[i] <= model::kMaxAbsTime)) {
+      return CheckTime(batch.times[i], absl::StrCat("times[", i, "]"));
+    }
+  }
+  return absl::OkStatus();
+}
 }  // namespace
 
 absl::Status CheckTime(double t, absl::string_view field) {
@@ -46,6 +70,9 @@ absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch) {
   if (batch.observation_count() > kMaxBatchObservations) {
     return absl::InvalidArgumentError(absl::StrCat("a batch may hold at most 2^28 observations, got ",
                                                    batch.observation_count()));
+  }
+  if (batch.is_history()) {
+    if (absl::Status s = ValidateHistory(map, batch); !s.ok()) return s;
   }
   if (patch_cells > 0) {
     if (map.kind != MapKind::kGrid) return absl::InvalidArgumentError("patch is only for grid maps");
@@ -127,23 +154,45 @@ void EncodePatchAndLabels(const ObservationBatch& batch, std::string& out) {
   }
 }
 
+uint64_t BitsOf(double t) { return std::bit_cast<uint64_t>(t); }
+
+void PutTimes(std::string* out, const std::vector<double>& times) {
+  const size_t at = out->size();
+  out->resize(at + times.size() * model::kMaxVarint64Bytes);
+  char* end = out->data() + at;
+  uint64_t previous = 0, previous_delta = 0;
+  for (double t : times) {
+    const uint64_t bits = BitsOf(t);
+    const uint64_t delta = bits - previous;  // wraps: exact in modular arithmetic
+    end = model::EncodeVarint64(end, model::ZigZagEncode64(static_cast<int64_t>(delta - previous_delta)));
+    previous = bits;
+    previous_delta = delta;
+  }
+  out->resize(end - out->data());
+}
 }  // namespace
 
-// Layout (version 1): version u8 | writer varint | sequence varint | time f64 |
+// Layout (version 1, a scan): version u8 | writer varint | sequence varint | time f64 |
 // key count varint | keys (delta-zigzag varints: scans are spatially sorted, so deltas are small) |
 // values f32 each | patch origin 3×varint | patch size 3×varint | patch values f32 each |
 // label count varint | labels (key varint, name, group as length-prefixed bytes).
 // Version 2 (compact cells): version u8 | writer | sequence | time | compact.indices as
 // length-prefixed bytes | value kind u8 (0 occupied bits, 1 probability bytes) | the values as
 // length-prefixed bytes | then as version 1 from the patch on.
+// Version 3, a history: as version 1, then one time per key, as the zigzag varints of the second
+// differences of the times' IEEE-754 bits (integer arithmetic modulo 2^64, starting from 0): exact
+// for any doubles, and a log sampled at a steady rate (a minute apart: the bits of times of one
+// binade step by the same integer) takes a byte a time instead of 8; an irregular one 4-5 bytes.
+// One state's history's keys, all the same, take a byte each.
 std::string EncodeBatch(const ObservationBatch& batch) {
   std::string out;
   const bool compact = !batch.compact.empty();
-  out.reserve(32 + (compact ? batch.compact.indices.size() + batch.compact.occupied.size() +
-                                  batch.compact.probabilities.size()
-                            : batch.keys.size() * model::kMaxVarint64Bytes + batch.keys.size() * 4) +
+  out.reserve(32 +
+              (compact ? batch.compact.indices.size() + batch.compact.occupied.size() +
+                             batch.compact.probabilities.size()
+                       : (batch.keys.size() + batch.times.size()) * model::kMaxVarint64Bytes + batch.keys.size() * 4) +
               batch.patch.values.size() * 4);
-  out.push_back(static_cast<char>(compact ? kCompactBatchVersion : kBatchVersion));
+  out.push_back(static_cast<char>(compact ? kCompactBatchVersion : batch.is_history() ? kHistoryVersion : kBatchVersion));
   model::PutVarint64(&out, batch.writer_id);
   model::PutVarint64(&out, batch.sequence);
   model::PutDouble(&out, batch.time);
@@ -168,6 +217,7 @@ std::string EncodeBatch(const ObservationBatch& batch) {
   out.resize(end - out.data());
   model::PutFloats(&out, batch.values);
   EncodePatchAndLabels(batch, out);
+  if (batch.is_history()) PutTimes(&out, batch.times);
   return out;
 }
 
@@ -175,7 +225,7 @@ absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes) {
   model::ByteReader r(bytes, "batch");
   ObservationBatch batch;
   const uint8_t version = r.Byte("version");
-  if (r.ok() && version != kBatchVersion && version != kCompactBatchVersion) {
+  if (r.ok() && version != kBatchVersion && version != kCompactBatchVersion && version != kHistoryVersion) {
     r.Fail("version", absl::StrCat("unknown version ", version));
   }
   batch.writer_id = r.Varint("writer_id");
@@ -232,6 +282,18 @@ absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes) {
     if (r.ok() && group_length > kMaxLabelLength) r.Fail("label.group length", "longer than 256");
     label.group = std::string(r.Bytes(r.ok() ? group_length : 0, "label.group"));
     batch.labels.push_back(std::move(label));
+  }
+  if (r.ok() && version == kHistoryVersion) {
+    // One time per key, each at least a byte; a history without a time is no history.
+    if (batch.keys.empty()) r.Fail("times", "a history without observations");
+    if (r.ok() && batch.keys.size() > r.remaining()) r.Fail("times", "more than the bytes left");
+    batch.times.resize(r.ok() ? batch.keys.size() : 0);
+    uint64_t previous = 0, delta = 0;
+    for (double& t : batch.times) {
+      delta += static_cast<uint64_t>(model::ZigZagDecode64(r.Varint("time")));
+      previous += delta;
+      t = std::bit_cast<double>(previous);
+    }
   }
   if (absl::Status s = r.Finish(); !s.ok()) return s;
   if (batch.observation_count() > kMaxBatchObservations) return absl::DataLossError("batch: too many observations");

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
 #include <random>
 
 #include "storage/cell_key.h"
@@ -118,6 +120,99 @@ TEST(BatchTest, CountsWhoseSizeWrapsAreDataLossNotAHugeAllocation) {
   auto patch = DecodeBatch(wrapping_patch);
   EXPECT_TRUE(absl::IsDataLoss(patch.status())) << patch.status();
   EXPECT_NE(patch.status().message().find("patch.size"), std::string::npos) << patch.status();
+}
+
+MapInfo Generic() {
+  MapInfo info;
+  info.name = "states";
+  info.kind = MapKind::kGeneric;
+  return info;
+}
+
+// One door's history: a minute apart, a state change now and then, one time twice.
+ObservationBatch History(size_t n) {
+  ObservationBatch batch;
+  batch.writer_id = 3;
+  batch.sequence = 12;
+  for (size_t i = 0; i < n; ++i) {
+    batch.keys.push_back(42);
+    batch.times.push_back(1.7e9 + 60.0 * static_cast<double>(i) + (i == 3 ? -60.0 : 0.0));
+    batch.values.push_back((i / 7) % 2 ? 1.0f : 0.0f);
+  }
+  return batch;
+}
+
+TEST(BatchTest, HistoryEncodingRoundTripsBitExactly) {
+  ObservationBatch batch = History(50);
+  // Times no delta coding of floats would keep: going back, tiny steps, odd fractions, a jump.
+  batch.times[10] = 0.0;
+  batch.times[11] = std::nextafter(1.7e9, 2e9);
+  batch.times[12] = 1.0 / 3.0;
+  batch.times[13] = 1e13;
+  batch.keys[20] = 7;  // another state in between
+  batch.labels.push_back({42, "front door", "doors"});
+  const std::string bytes = EncodeBatch(batch);
+  EXPECT_EQ(bytes[0], 3) << "a history is version 3";
+  auto decoded = DecodeBatch(bytes);
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ(*decoded, batch);
+  for (size_t i = 0; i < batch.times.size(); ++i) {
+    EXPECT_EQ(std::bit_cast<uint64_t>(decoded->times[i]), std::bit_cast<uint64_t>(batch.times[i])) << i;
+  }
+}
+
+TEST(BatchTest, ScansStayVersion1SoTheirFingerprintsDoNotChange) {
+  EXPECT_EQ(EncodeBatch(Scan())[0], 1);
+  auto decoded = DecodeBatch(EncodeBatch(Scan()));
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_TRUE(decoded->times.empty());
+}
+
+TEST(BatchTest, OneStatesHistoryAMinuteApartTakesSixBytesAnObservation) {
+  ObservationBatch batch = History(96'000);
+  batch.times[3] = batch.times[2] + 60;  // steady throughout
+  const std::string bytes = EncodeBatch(batch);
+  // A key byte (delta 0), a float, and the time's second difference (0 at a steady rate, a byte)
+  // instead of 8 bytes of double; the time's step changes at 2^31 s (a new binade): a few bytes.
+  EXPECT_LE(bytes.size(), 6 * batch.keys.size() + 64) << bytes.size();
+}
+
+TEST(BatchTest, HistoryProblemsNameTheField) {
+  const MapInfo map = Generic();
+  EXPECT_TRUE(ValidateBatch(map, History(10)).ok());
+  ObservationBatch batch = History(10);
+  batch.times[4] = NAN;
+  EXPECT_NE(ValidateBatch(map, batch).message().find("times[4]"), std::string::npos) << ValidateBatch(map, batch);
+  batch.times[4] = -1;
+  EXPECT_NE(ValidateBatch(map, batch).message().find("times[4]"), std::string::npos);
+  batch.times[4] = 2e13;
+  EXPECT_TRUE(absl::IsInvalidArgument(ValidateBatch(map, batch)));
+  batch = History(10);
+  batch.times.pop_back();
+  EXPECT_NE(ValidateBatch(map, batch).message().find("times must hold one time per state"), std::string::npos);
+  batch = History(10);
+  batch.time = 5;
+  EXPECT_NE(ValidateBatch(map, batch).message().find("time must be 0"), std::string::npos);
+  EXPECT_NE(ValidateBatch(Grid(), History(10)).message().find("only for generic maps"), std::string::npos);
+}
+
+TEST(BatchTest, HistoryValuesOutOfRangeAreRejectedOneByOne) {
+  ObservationBatch batch = History(10);
+  batch.values[2] = 1.5f;
+  batch.values[8] = NAN;
+  std::vector<uint8_t> accept;
+  const BatchAck ack = Classify(Generic(), batch, accept);
+  EXPECT_EQ(ack.accepted, 8u);
+  ASSERT_EQ(ack.rejections.size(), 2u);
+  EXPECT_EQ(ack.rejections[0].index, 2u);
+  EXPECT_EQ(ack.rejections[1].index, 8u);
+}
+
+TEST(BatchTest, DamagedHistoryBytesAreDataLoss) {
+  const std::string good = EncodeBatch(History(20));
+  for (size_t n = 0; n < good.size(); ++n) EXPECT_FALSE(DecodeBatch(good.substr(0, n)).ok()) << n;
+  std::string extra = good + '\x01';
+  EXPECT_TRUE(absl::IsDataLoss(DecodeBatch(extra).status()));
 }
 
 }  // namespace

@@ -164,13 +164,13 @@ absl::Status MapStoreImpl::Recover() {
     }
     dedup_.Record(batch->writer_id, batch->sequence,
                   BatchFingerprint({reinterpret_cast<const char*>(payload.data()) + 1, payload.size() - 1}));
-    Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}, {}};
+    Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}, {}, {}, {}};
     pending.ack = Classify(info_, pending.batch, pending.accept);
     SplitByShard(pending);
     const ScanContext scan(settings_->periods, pending.batch.time);
     for (uint32_t s = 0; s < shards_.size(); ++s) {
       if (shards_[s]->checkpoint_lsn() >= lsn) continue;  // the checkpoint has it already
-      shards_[s]->Apply(scan, pending.keys[s], pending.values[s]);
+      ApplyToShard(s, pending, scan);
       shards_[s]->ApplyLabels(pending.labels[s]);
     }
     return absl::OkStatus();
@@ -208,7 +208,7 @@ absl::Status MapStoreImpl::Recover() {
 }
 
 MapStoreImpl::Pending MapStoreImpl::Prepare(ObservationBatch batch, AckCallback done) const {
-  Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}, {}};
+  Pending pending{std::move(batch), std::move(done), {}, {}, {}, {}, {}, {}, {}, {}};
   pending.ack = Classify(info_, pending.batch, pending.accept);
   pending.record.push_back(kBatchRecord);
   pending.record += EncodeBatch(pending.batch);
@@ -236,14 +236,33 @@ void MapStoreImpl::SplitByShard(Pending& pending) const {
   // computed once per run of the brick's keys.
   uint64_t brick = ~uint64_t{0};
   uint32_t shard = 0;
+  // A history's runs: the batch's observations split where the time changes (rejected ones
+  // included, as in the scans the history stands for), each shard's part of a run one run of it.
+  std::vector<uint64_t> last_run;  // by shard, the batch run its last run is part of, +1
+  uint64_t run = 0;
+  if (b.is_history()) {
+    pending.runs.assign(info_.shards, {});
+    last_run.assign(info_.shards, 0);
+  }
   for (size_t i = 0; i < b.keys.size(); ++i) {
+    if (b.is_history() && i > 0 && b.times[i] != b.times[i - 1]) ++run;
     if (!pending.accept[i]) continue;
     if (BrickOf(b.keys[i]) != brick) {
       brick = BrickOf(b.keys[i]);
       shard = ShardOf(b.keys[i], info_.shards);
     }
-    keys[shard].push_back(b.keys[i]);
-    values[shard].push_back(b.values[i]);
+    const uint32_t s = shard;
+    if (b.is_history()) {
+      const uint32_t end = static_cast<uint32_t>(keys[s].size()) + 1;
+      if (last_run[s] == run + 1) {
+        pending.runs[s].back().end = end;
+      } else {
+        pending.runs[s].push_back({b.times[i], end});
+        last_run[s] = run + 1;
+      }
+    }
+    keys[s].push_back(b.keys[i]);
+    values[s].push_back(b.values[i]);
   }
   const DensePatch& p = b.patch;
   const GridKeys grid_keys = info_.grid.keys();
@@ -263,9 +282,17 @@ void MapStoreImpl::SplitByShard(Pending& pending) const {
 
 absl::Status MapStoreImpl::Submit(ObservationBatch batch, AckCallback done) {
   if (absl::Status valid = ValidateBatch(info_, batch); !valid.ok()) return valid;
-  if (info_.lossless_sampling_period > 0 && batch.time < info_.lossless_origin) {
+  if (info_.lossless_sampling_period > 0 && batch.time < info_.lossless_origin && !batch.is_history()) {
     return absl::InvalidArgumentError(absl::StrCat("time must not be before the map's lossless origin ",
                                                    info_.lossless_origin, ", got ", batch.time));
+  }
+  if (info_.lossless_sampling_period > 0) {
+    for (size_t i = 0; i < batch.times.size(); ++i) {
+      if (batch.times[i] < info_.lossless_origin) {
+        return absl::InvalidArgumentError(absl::StrCat("times[", i, "] must not be before the map's lossless origin ",
+                                                       info_.lossless_origin, ", got ", batch.times[i]));
+      }
+    }
   }
   const uint64_t n = batch.observation_count();
   const auto refusal = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(queue_mutex_) -> absl::Status {
@@ -566,6 +593,21 @@ void MapStoreImpl::ApplyLoop() {
   }
 }
 
+void MapStoreImpl::ApplyToShard(uint32_t s, const Pending& pending, const ScanContext& scan) const {
+  const std::span<const uint64_t> keys = pending.keys[s];
+  const std::span<const float> values = pending.values[s];
+  if (pending.runs.empty()) {
+    shards_[s]->Apply(scan, keys, values);
+    return;
+  }
+  uint32_t begin = 0;
+  for (const Pending::Run& run : pending.runs[s]) {
+    shards_[s]->Apply(ScanContext(settings_->periods, run.time), keys.subspan(begin, run.end - begin),
+                      values.subspan(begin, run.end - begin));
+    begin = run.end;
+  }
+}
+
 void MapStoreImpl::ApplyGroup(std::vector<Pending>& group) {
   // Every shard folds in its part of every batch, in batch order.
   std::vector<const Pending*> fresh;
@@ -578,7 +620,7 @@ void MapStoreImpl::ApplyGroup(std::vector<Pending>& group) {
   if (!fresh.empty()) {
     workers_->RunOnAll([&](uint32_t s) {
       for (size_t b = 0; b < fresh.size(); ++b) {
-        shards_[s]->Apply(scans[b], fresh[b]->keys[s], fresh[b]->values[s]);
+        ApplyToShard(s, *fresh[b], scans[b]);
         if (!fresh[b]->labels[s].empty()) shards_[s]->ApplyLabels(fresh[b]->labels[s]);
       }
     });

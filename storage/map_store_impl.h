@@ -82,6 +82,13 @@ class MapStoreImpl final : public MapStore {
     std::vector<std::vector<float>> values;
     std::vector<std::vector<StateLabel>> labels;  // the batch's labels by shard
     uint64_t fingerprint = 0;  // BatchFingerprint of the record's batch
+    // A history's runs by shard: keys[s][previous run's end, end) were observed at `time`. Empty
+    // for a scan, whose keys were all observed at batch.time.
+    struct Run {
+      double time;
+      uint32_t end;
+    };
+    std::vector<std::vector<Run>> runs;
   };
   // Requests the committer serves between groups, in order.
   struct Control {
@@ -129,8 +136,11 @@ class MapStoreImpl final : public MapStore {
   void ContinuePublication();
   void FinishPublication();
   absl::StatusOr<uint64_t> RunControl(Control::Kind kind, std::function<void(uint64_t, uint64_t)> progress = nullptr);
-  // Splits the accepted observations and the labels of a batch by shard.
+  // Splits the accepted observations and the labels of a batch by shard (a history's runs too).
   void SplitByShard(Pending& pending) const;
+  // Folds shard s's part of a batch into it: a scan at `scan`'s time, a history run by run, each
+  // run as the scan it stands for (so that a history and its scans give bit-identical models).
+  void ApplyToShard(uint32_t s, const Pending& pending, const ScanContext& scan) const;
   // Classifies, encodes and splits a batch.
   Pending Prepare(ObservationBatch batch, AckCallback done) const;
   void IndexLabels(std::span<const StateLabel> labels) ABSL_LOCKS_EXCLUDED(groups_mutex_);

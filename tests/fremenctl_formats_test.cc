@@ -118,7 +118,7 @@ TEST_F(FremenctlFormatsTest, IngestStatesFileThenModelPrintsIt) {
   const RunResult ingest = RunOk(
       {"ingest", "--map", "lab", "--states", WriteDoorFile("week1.txt", 7), "--name", "door", "--create", "--update"});
   EXPECT_THAT(ingest.out, HasSubstr("created generic map lab"));
-  EXPECT_THAT(ingest.out, HasSubstr("1008 batches, 1008 observations accepted, 0 rejected"));
+  EXPECT_THAT(ingest.out, HasSubstr("1 batch, 1008 observations accepted, 0 rejected"));
   EXPECT_THAT(ingest.out, HasSubstr("update of lab: 1 states published"));
   const RunResult second =
       RunOk({"ingest", "--map", "lab", "--states", WriteDoorFile("week2.txt", 7, 7), "--name", "door", "--update"});

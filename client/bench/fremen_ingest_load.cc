@@ -9,11 +9,19 @@
 // The map (default "ingest-load", a 100×100×100 grid = 1M cells) is created when missing. Each
 // run writes as new writers (random ids), so runs against the same map are never duplicates.
 //
+// --history-states N streams histories instead (IngestRequest.history, a time per observation)
+// into a generic map (default "ingest-load-history"): each batch --cells observations, a minute
+// apart, of one state per stream (N = 1: one door's log uploaded) or of N states per stream in
+// turn. Printed beside it, as the ceiling of the same run: how fast one core computes the phasors
+// of the map's default 24 periods, which the daemon needs once per distinct time and which no
+// batching amortises (every observation of one state's history is at a time of its own).
+//
 // Uses only the API (fremen_proto + gRPC), as any client does. Threads: a writer and a reader per
 // stream; the main thread samples the counters.
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -60,7 +68,10 @@ struct Options {
   // "cells": CellObservations (x, y, z arrays and floats); "compact": CompactCells (index gaps and
   // occupied bits).
   std::string encoding = "cells";
+  uint32_t history_states = 0;  // 0: scans of cells; else histories of this many states per stream
 };
+
+constexpr double kHistoryInterval = 60;  // seconds between a history's observations of a state
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
@@ -112,6 +123,16 @@ bool Client::EnsureMap() const {
   get.set_map(o_.map);
   v1::GetMapResponse got;
   grpc::Status status = maps_->GetMap(Context().get(), get, &got);
+  const v1::MapKind kind = o_.history_states > 0 ? v1::MAP_KIND_GENERIC : v1::MAP_KIND_GRID;
+  if (status.ok() && got.map().kind() != kind) {
+    std::fprintf(stderr, "map %s is not a %s map; choose another --map\n", o_.map.c_str(),
+                 kind == v1::MAP_KIND_GRID ? "grid" : "generic");
+    return false;
+  }
+  if (status.ok() && kind == v1::MAP_KIND_GENERIC) {
+    std::printf("map %s: generic, %u shards\n", o_.map.c_str(), got.map().shards());
+    return true;
+  }
   if (status.ok()) {
     const v1::GridSize& size = got.map().grid().size();
     if (size.x() != o_.grid || size.y() != o_.grid || size.z() != o_.grid) {
@@ -130,16 +151,22 @@ bool Client::EnsureMap() const {
   v1::CreateMapRequest create;
   v1::Map& map = *create.mutable_map();
   map.set_name(o_.map);
-  map.set_kind(v1::MAP_KIND_GRID);
-  map.mutable_grid()->set_resolution(0.05);
-  map.mutable_grid()->mutable_size()->set_x(o_.grid);
-  map.mutable_grid()->mutable_size()->set_y(o_.grid);
-  map.mutable_grid()->mutable_size()->set_z(o_.grid);
+  map.set_kind(kind);
+  if (kind == v1::MAP_KIND_GRID) {
+    map.mutable_grid()->set_resolution(0.05);
+    map.mutable_grid()->mutable_size()->set_x(o_.grid);
+    map.mutable_grid()->mutable_size()->set_y(o_.grid);
+    map.mutable_grid()->mutable_size()->set_z(o_.grid);
+  }
   v1::CreateMapResponse created;
   status = maps_->CreateMap(Context().get(), create, &created);
   if (!status.ok()) {
     std::fprintf(stderr, "CreateMap %s: %s\n", o_.map.c_str(), status.error_message().c_str());
     return false;
+  }
+  if (kind == v1::MAP_KIND_GENERIC) {
+    std::printf("created generic map %s, %u shards\n", o_.map.c_str(), created.map().shards());
+    return true;
   }
   std::printf("created map %s: %u×%u×%u cells, %u shards\n", o_.map.c_str(), o_.grid, o_.grid, o_.grid,
               created.map().shards());
@@ -185,13 +212,59 @@ v1::IngestRequest MakeScan(const Options& o, int stream, int k, std::mt19937_64&
   return request;
 }
 
+// History k of a stream: --cells observations of the stream's --history-states states in turn, a
+// minute apart per state, a door's values (open for a stretch now and then); the writer shifts the
+// times of each batch it sends past the previous one's.
+v1::IngestRequest MakeHistory(const Options& o, int stream, std::mt19937_64& random) {
+  v1::IngestRequest request;
+  request.set_map(o.map);
+  v1::HistoryObservations& h = *request.mutable_history();
+  h.mutable_times()->Reserve(o.cells);
+  h.mutable_values()->Reserve(o.cells);
+  const uint64_t first_id = static_cast<uint64_t>(stream) << 32;
+  if (o.history_states == 1) h.add_ids(first_id);
+  for (uint32_t i = 0; i < o.cells; ++i) {
+    if (o.history_states > 1) h.add_ids(first_id + i % o.history_states);
+    h.add_times(kT0 + kHistoryInterval * static_cast<double>(i / o.history_states));
+    h.add_values(random() % 50 < (i / 97 % 3 == 0 ? 45 : 5) ? 1.0f : 0.0f);
+  }
+  return request;
+}
+
+// Batch k of a stream, either kind.
+v1::IngestRequest MakeBatch(const Options& o, int stream, int k, std::mt19937_64& random) {
+  return o.history_states > 0 ? MakeHistory(o, stream, random) : MakeScan(o, stream, k, random);
+}
+
+// The ceiling of a history: phasors of the default 24 periods (604800 / k s) at one distinct time
+// per observation, as the daemon computes them (storage/model/phasor.cc: fmod, then cos and sin),
+// one core. Printed as observations per second.
+void MeasurePhasorCeiling(const Options& o) {
+  constexpr int kPeriods = 24;
+  constexpr int kTimes = 200'000;
+  double sink = 0;
+  const auto start = Clock::now();
+  for (int i = 0; i < kTimes; ++i) {
+    const double t = kT0 + kHistoryInterval * i;
+    for (int k = 1; k <= kPeriods; ++k) {
+      const double period = 604800.0 / k;
+      const double phase = 2.0 * 3.141592653589793 * (std::fmod(t, period) / period);
+      sink += std::cos(phase) + std::sin(phase);
+    }
+  }
+  const double elapsed = Seconds(Clock::now() - start);
+  std::printf("ceiling: phasors of %d periods at a new time, one core: %.2fM obs/s (checksum %.3f)\n", kPeriods,
+              kTimes / elapsed / 1e6, sink);
+  (void)o;
+}
+
 // What one scan costs on the wire and to encode and decode, one core.
 void MeasureEncoding(const Options& o) {
   std::mt19937_64 random(1);
-  v1::IngestRequest scan = MakeScan(o, 0, 0, random);
+  v1::IngestRequest scan = MakeBatch(o, 0, 0, random);
   scan.set_writer_id(1);
   scan.set_sequence(12345);
-  scan.set_time(kT0);
+  if (o.history_states == 0) scan.set_time(kT0);
   constexpr int kReps = 200;
   std::string bytes;
   auto start = Clock::now();
@@ -201,10 +274,12 @@ void MeasureEncoding(const Options& o) {
   start = Clock::now();
   for (int i = 0; i < kReps; ++i) parsed.ParseFromString(bytes);
   const double decode = Seconds(Clock::now() - start) / kReps;
-  std::printf("%s: one scan of %u cells: %zu bytes (%.1f per cell); encode %.0f µs, decode %.0f µs "
-              "(%.0fM cells/s to decode on one core)\n",
-              o.encoding.c_str(), o.cells, bytes.size(), static_cast<double>(bytes.size()) / o.cells, encode * 1e6,
-              decode * 1e6,
+  const bool history = o.history_states > 0;
+  std::printf("%s: one %s of %u %s: %zu bytes (%.1f per observation); encode %.0f µs, decode %.0f µs "
+              "(%.0fM observations/s to decode on one core)\n",
+              history ? "history" : o.encoding.c_str(), history ? "history" : "scan", o.cells,
+              history ? "observations" : "cells", bytes.size(), static_cast<double>(bytes.size()) / o.cells,
+              encode * 1e6, decode * 1e6,
               o.cells / decode / 1e6);
 }
 
@@ -220,7 +295,7 @@ class LoadStream {
     context_ = client_.Context();
     stream_ = stub_->Ingest(context_.get());
     std::mt19937_64 random(index_);
-    for (int k = 0; k < kScansPerStream; ++k) scans_.push_back(MakeScan(o_, index_, k, random));
+    for (int k = 0; k < kScansPerStream; ++k) scans_.push_back(MakeBatch(o_, index_, k, random));
     sent_at_.resize(static_cast<size_t>(o_.window) * 2);
     reader_ = std::thread([this] { Read(); });
     writer_ = std::thread([this] { Write(); });
@@ -265,7 +340,16 @@ class LoadStream {
       v1::IngestRequest& scan = scans_[sequence % scans_.size()];
       scan.set_writer_id(writer_id_);
       scan.set_sequence(sequence);
-      scan.set_time(kT0 + kScanInterval * static_cast<double>(sequence));
+      if (o_.history_states > 0) {
+        // Right after the previous batch's times: a log uploaded in order.
+        const double span = kHistoryInterval * std::ceil(static_cast<double>(o_.cells) / o_.history_states);
+        double& base = history_base_[sequence % scans_.size()];
+        const double shift = kT0 + span * static_cast<double>(sequence) - base;
+        for (double& t : *scan.mutable_history()->mutable_times()) t += shift;
+        base += shift;
+      } else {
+        scan.set_time(kT0 + kScanInterval * static_cast<double>(sequence));
+      }
       if (!stream_->Write(scan)) break;
     }
     stream_->WritesDone();
@@ -300,6 +384,7 @@ class LoadStream {
   std::unique_ptr<grpc::ClientContext> context_;
   std::unique_ptr<grpc::ClientReaderWriter<v1::IngestRequest, v1::IngestResponse>> stream_;
   std::vector<v1::IngestRequest> scans_;
+  std::vector<double> history_base_ = std::vector<double>(kScansPerStream, kT0);  // each history's first time
   std::thread reader_, writer_;
 
   std::mutex mutex_;
@@ -355,7 +440,7 @@ bool RunIngest(const Options& o, const Client& client) {
     const double elapsed = Seconds(Clock::now() - start);
     rates.push_back(static_cast<double>(obs1 - obs0) / elapsed);
     batch_rates.push_back(static_cast<double>(batches1 - batches0) / elapsed);
-    std::printf("  window %d: %.2fM cell-obs/s, %.0f batches/s\n", r + 1, rates.back() / 1e6, batch_rates.back());
+    std::printf("  window %d: %.2fM obs/s, %.0f batches/s\n", r + 1, rates.back() / 1e6, batch_rates.back());
     std::fflush(stdout);
   }
   for (auto& s : streams) {
@@ -371,9 +456,13 @@ bool RunIngest(const Options& o, const Client& client) {
     }
   }
   std::sort(latencies.begin(), latencies.end());
-  std::printf("ingest: %d streams × %u-cell scans, ≤ %d unacknowledged each: median %.2fM cell-obs/s "
+  const std::string what = o.history_states > 0
+                               ? std::to_string(o.cells) + "-observation histories of " +
+                                     std::to_string(o.history_states) + " state(s)"
+                               : std::to_string(o.cells) + "-cell scans";
+  std::printf("ingest: %d streams × %s, ≤ %d unacknowledged each: median %.2fM obs/s "
               "(%.0f batches/s) over %zu windows of %.0f s; ack latency p50 %.1f ms, p99 %.1f ms\n",
-              o.streams, o.cells, o.window, Median(rates) / 1e6, Median(batch_rates), rates.size(), o.seconds,
+              o.streams, what.c_str(), o.window, Median(rates) / 1e6, Median(batch_rates), rates.size(), o.seconds,
               Quantile(latencies, 0.5) * 1e3, Quantile(latencies, 0.99) * 1e3);
   return ok;
 }
@@ -426,13 +515,20 @@ int main(int argc, char** argv) {
   app.add_option("--warmup", o.warmup, "seconds before measuring")->capture_default_str();
   app.add_option("--seconds", o.seconds, "seconds per measured window")->capture_default_str();
   app.add_option("--repetitions", o.repetitions, "measured windows (the median is reported)")->capture_default_str()->check(CLI::Range(1, 1000));
+  app.add_option("--history-states", o.history_states,
+                 "stream histories (a time per observation) of this many states per stream into a generic map "
+                 "instead of scans (0: scans); --cells is then the observations per batch")
+      ->capture_default_str();
   app.add_option("--predict-calls", o.predict_calls, "single-state Predict calls afterwards (0: none)")->capture_default_str();
   app.add_option("--encoding", o.encoding, "cells (CellObservations) or compact (CompactCells)")
       ->capture_default_str()
       ->check(CLI::IsMember({"cells", "compact"}));
   app.add_option("--batches", o.batches, "send exactly this many batches per stream, then stop (a fixed workload; 0: timed windows)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  if (uint64_t{o.grid} * o.grid * o.grid < o.cells) {
+  if (o.history_states > 0) {
+    if (app.count("--map") == 0) o.map = "ingest-load-history";
+    o.predict_calls = 0;  // the Predict latency is of grid cells
+  } else if (uint64_t{o.grid} * o.grid * o.grid < o.cells) {
     std::fprintf(stderr, "--cells %u exceeds the grid's %u³ cells\n", o.cells, o.grid);
     return 2;
   }
@@ -441,6 +537,7 @@ int main(int argc, char** argv) {
   if (!client.EnsureMap()) return 1;
   if (o.batches > 0) return RunFixed(o, client) ? 0 : 1;
   MeasureEncoding(o);
+  if (o.history_states > 0) MeasurePhasorCeiling(o);
   const bool ok = RunIngest(o, client);
   client.Predict();
   return ok ? 0 : 1;

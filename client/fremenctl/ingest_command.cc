@@ -13,6 +13,7 @@
 #include "client/fremenctl/connection.h"
 #include "client/fremenctl/map_writer.h"
 #include "client/fremenctl/offline_eval.h"
+#include "client/lib/history_builder.h"
 
 namespace fremen::client {
 
@@ -72,7 +73,16 @@ void IngestStates(const Client& client, const IngestArgs& args) {
     CreateMapIfMissing(client, NewMap(args.map, v1::MAP_KIND_GENERIC), kCommand);
   }
   MapWriter writer(client, args.map, kCommand);
-  for (const model::Observation& o : *observations) writer.SendState(o.t, args.state_name, args.state_id, o.s);
+  // The file's observations as histories (a time per observation), many per batch: one batch per
+  // line took a log record and an acknowledgement per observation. In file order, which the
+  // daemon keeps, so a file in time order gives the model of a robot that streamed it.
+  HistoryBuilder history =
+      args.state_name.empty() ? HistoryBuilder::ForId(args.state_id) : HistoryBuilder::ForName(args.state_name);
+  for (const model::Observation& o : *observations) {
+    history.Add(o.t, static_cast<float>(o.s));
+    if (history.size() == kHistoryBatchObservations) writer.SendScan(history.Build());
+  }
+  if (history.size() > 0) writer.SendScan(history.Build());
   const IngestTotals totals = writer.Finish();
   std::printf("ingested %s into %s: %s\n", args.states_file.c_str(), args.map.c_str(),
               MapWriter::Summary(totals, writer.first_rejections()).c_str());

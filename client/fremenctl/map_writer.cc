@@ -66,16 +66,6 @@ void MapWriter::Send(const formats::NamedStateBatch& batch) {
   SendScan(builder.Build());
 }
 
-void MapWriter::SendState(double time, const std::string& name, uint64_t id, float value) {
-  ScanBuilder builder(time);
-  if (name.empty()) {
-    builder.AddState(id, value);
-  } else {
-    builder.AddNamedState(name, value);
-  }
-  SendScan(builder.Build());
-}
-
 void MapWriter::Flush() {
   if (absl::Status flushed = session_->Flush(); !flushed.ok()) FailCall(command_, "ingest failed", flushed, map_);
 }
@@ -92,7 +82,7 @@ IngestTotals MapWriter::Finish() {
 }
 
 std::string MapWriter::Summary(const IngestTotals& totals, const std::string& first_rejections) {
-  std::string text = absl::StrCat(totals.sent, " batches, ", totals.accepted, " observations accepted, ",
+  std::string text = absl::StrCat(totals.sent, totals.sent == 1 ? " batch, " : " batches, ", totals.accepted, " observations accepted, ",
                                   totals.rejected, " rejected");
   if (totals.rejected > 0 && !first_rejections.empty()) absl::StrAppend(&text, " (", first_rejections, ")");
   return text;

@@ -1,5 +1,5 @@
 // Writing many observation batches into one map for fremenctl's ingest and demo: an IngestSession
-// (client/lib) fed with CellBatch / NamedStateBatch / single observations, whose acks are tallied
+// (client/lib) fed with CellBatch / NamedStateBatch / built scans and histories, whose acks are tallied
 // so that the command can report accepted, rejected and refused, and the first reasons. Also the
 // map creation and the update that ingest --create / --update and demo share.
 // Thread-compatible: one command drives one writer.
@@ -26,8 +26,8 @@ class MapWriter {
   // Queue one batch; a batch the session refuses to take ends the command.
   void Send(const formats::CellBatch& batch);
   void Send(const formats::NamedStateBatch& batch);
-  // One observation of one generic state by name, or by id when `name` is empty.
-  void SendState(double time, const std::string& name, uint64_t id, float value);
+  // A built batch (a scan or a history); a builder's error ends the command as bad input.
+  void SendScan(absl::StatusOr<Scan> scan);
 
   // Waits until every batch sent so far is acknowledged (applied), e.g. before an update that must
   // see them; a failed session ends the command.
@@ -40,8 +40,6 @@ class MapWriter {
   const std::string& first_rejections() const { return first_rejections_; }
 
  private:
-  void SendScan(absl::StatusOr<Scan> scan);
-
   std::string map_;
   std::string command_;
   std::unique_ptr<IngestSession> session_;

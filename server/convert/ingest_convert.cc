@@ -3,9 +3,11 @@
 #include <array>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "storage/model/observation.h"
 #include "storage/state_names.h"
 
 namespace fremen::server {
@@ -43,6 +45,24 @@ absl::Status CheckOptionalLength(absl::string_view field, size_t got, absl::stri
 absl::Status CheckLabel(absl::string_view field, int i, const std::string& text) {
   if (text.size() <= storage::kMaxLabelLength) return absl::OkStatus();
   return Invalid(absl::StrCat(field, "[", i, "] has ", text.size(), " bytes; at most ", storage::kMaxLabelLength, " allowed"));
+}
+
+// The labels of a message whose names and groups are each empty or one per state (lengths checked
+// already): label i, unless both are empty, is of state key_of(i). `message` ("states",
+// "history") names the fields in errors.
+template <typename KeyOf>
+absl::Status AddLabels(absl::string_view message, const google::protobuf::RepeatedPtrField<std::string>& names,
+                       const google::protobuf::RepeatedPtrField<std::string>& groups, KeyOf key_of,
+                       ObservationBatch& batch) {
+  for (int i = 0; i < names.size() || i < groups.size(); ++i) {
+    const std::string& name = names.empty() ? NoLabel() : names[i];
+    const std::string& group = groups.empty() ? NoLabel() : groups[i];
+    if (name.empty() && group.empty()) continue;
+    if (auto s = CheckLabel(absl::StrCat(message, ".names"), i, name); !s.ok()) return s;
+    if (auto s = CheckLabel(absl::StrCat(message, ".groups"), i, group); !s.ok()) return s;
+    batch.labels.push_back({key_of(i), name, group});
+  }
+  return absl::OkStatus();
 }
 
 absl::Status CheckKind(const MapInfo& map, absl::string_view what, MapKind wanted) {
@@ -120,15 +140,7 @@ absl::Status FromStates(const v1::StateObservations& states, ObservationBatch& b
   if (auto s = CheckOptionalLength("states.groups", states.groups_size(), "groups", n, "ids"); !s.ok()) return s;
   batch.keys.assign(states.ids().begin(), states.ids().end());
   CopyValues(states.values(), batch);
-  for (int i = 0; i < states.names_size() || i < states.groups_size(); ++i) {
-    const std::string& name = states.names_size() > 0 ? states.names(i) : NoLabel();
-    const std::string& group = states.groups_size() > 0 ? states.groups(i) : NoLabel();
-    if (name.empty() && group.empty()) continue;
-    if (auto s = CheckLabel("states.names", i, name); !s.ok()) return s;
-    if (auto s = CheckLabel("states.groups", i, group); !s.ok()) return s;
-    batch.labels.push_back({states.ids(i), name, group});
-  }
-  return absl::OkStatus();
+  return AddLabels("states", states.names(), states.groups(), [&](int i) { return states.ids(i); }, batch);
 }
 
 absl::Status FromNamedStates(const v1::NamedStateObservations& named, ObservationBatch& batch) {
@@ -152,6 +164,59 @@ absl::Status FromNamedStates(const v1::NamedStateObservations& named, Observatio
   }
   CopyValues(named.values(), batch);
   return absl::OkStatus();
+}
+
+// One state's history (a single id) or many states' (an id per value), each observation with its
+// own time; the request's time must stay unset. The times are checked here so that the message
+// names history.times rather than the store's times.
+absl::Status FromHistory(const v1::IngestRequest& request, ObservationBatch& batch) {
+  const v1::HistoryObservations& history = request.history();
+  const size_t n = history.values_size();
+  if (request.time() != 0) {
+    return Invalid(absl::StrCat("time must be 0 (unset) with history, whose observations carry their own times "
+                                "(history.times); got ",
+                                request.time()));
+  }
+  if (auto s = CheckLength("history.times", history.times_size(), "times", n, "values"); !s.ok()) return s;
+  // The states: by ids, which names and groups label, or, without ids, by names, as named_states.
+  const bool by_name = history.ids_size() == 0 && history.names_size() > 0;
+  const size_t ids = by_name ? history.names_size() : history.ids_size();
+  const absl::string_view id_field = by_name ? "history.names" : "history.ids";
+  if (ids != 1) {
+    if (auto s = CheckLength(id_field, ids, by_name ? "names" : "ids", n, "values (or exactly 1: one state's history)");
+        !s.ok()) {
+      return s;
+    }
+  }
+  if (!by_name) {
+    if (auto s = CheckOptionalLength("history.names", history.names_size(), "names", ids, "ids"); !s.ok()) return s;
+  }
+  if (auto s = CheckOptionalLength("history.groups", history.groups_size(), "groups", ids, by_name ? "names" : "ids");
+      !s.ok()) {
+    return s;
+  }
+  const double* times = history.times().data();
+  for (size_t i = 0; i < n; ++i) {
+    if (!(times[i] >= 0.0 && times[i] <= model::kMaxAbsTime)) {
+      return storage::CheckTime(times[i], absl::StrCat("history.times[", i, "]"));
+    }
+  }
+  batch.times.assign(history.times().begin(), history.times().end());
+  std::vector<uint64_t> keys(ids);
+  for (size_t i = 0; i < ids; ++i) {
+    if (by_name && history.names(i).empty()) {
+      return Invalid(absl::StrCat("history.names[", i, "] is empty; every state needs a name"));
+    }
+    keys[i] = by_name ? storage::StateIdOfName(history.names(i)) : history.ids(i);
+  }
+  if (ids == 1) {
+    batch.keys.assign(n, keys[0]);
+  } else {
+    batch.keys = std::move(keys);
+  }
+  CopyValues(history.values(), batch);
+  return AddLabels("history", history.names(), history.groups(),
+                   [&](int i) { return ids == 1 ? batch.keys[0] : batch.keys[i]; }, batch);
 }
 
 // x·y·z, saturated: a patch of 2^32 cells along each axis must not wrap around to a small count.
@@ -218,10 +283,14 @@ absl::Status FillObservations(const MapInfo& map, const v1::IngestRequest& reque
     case v1::IngestRequest::kNamedStates:
       if (auto s = CheckKind(map, "named_states", MapKind::kGeneric); !s.ok()) return s;
       return FromNamedStates(request.named_states(), batch);
+    case v1::IngestRequest::kHistory:
+      if (auto s = CheckKind(map, "history observations", MapKind::kGeneric); !s.ok()) return s;
+      return FromHistory(request, batch);
     case v1::IngestRequest::OBSERVATIONS_NOT_SET:
       break;
   }
-  return Invalid("observations are required: one of cells, points, states, named_states, patch or compact");
+  return Invalid(
+      "observations are required: one of cells, points, states, named_states, patch, compact or history");
 }
 
 v1::RejectReason ReasonToProto(storage::RejectReason reason) {

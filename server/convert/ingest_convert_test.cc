@@ -302,6 +302,75 @@ TEST(IngestConvertTest, ValuesAreLeftForTheStoreToClassify) {
   for (const storage::Rejection& r : ack.rejections) EXPECT_EQ(r.reason, storage::RejectReason::kValueOutOfRange);
 }
 
+v1::IngestRequest History(std::initializer_list<double> times) {
+  v1::IngestRequest request = Request();
+  request.clear_time();
+  for (double t : times) {
+    request.mutable_history()->add_times(t);
+    request.mutable_history()->add_values(1.0f);
+  }
+  return request;
+}
+
+TEST(IngestConvertTest, OneStatesHistoryGivesEveryObservationItsIdAndTime) {
+  v1::IngestRequest request = History({1.7e9, 1.7e9 + 60, 1.7e9 + 60});
+  request.mutable_history()->add_ids(42);
+  request.mutable_history()->add_names("front door");
+  auto batch = BatchFromRequest(Generic(), request);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_THAT(batch->keys, ElementsAre(42u, 42u, 42u));
+  EXPECT_THAT(batch->times, ElementsAre(1.7e9, 1.7e9 + 60, 1.7e9 + 60));
+  EXPECT_EQ(batch->time, 0.0);
+  ASSERT_EQ(batch->labels.size(), 1u);
+  EXPECT_EQ(batch->labels[0].name, "front door");
+  EXPECT_TRUE(storage::ValidateBatch(Generic(), *batch).ok());
+}
+
+TEST(IngestConvertTest, ManyStatesHistoryTakesAnIdPerObservation) {
+  v1::IngestRequest request = History({5, 6});
+  request.mutable_history()->add_ids(1);
+  request.mutable_history()->add_ids(2);
+  auto batch = BatchFromRequest(Generic(), request);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_THAT(batch->keys, ElementsAre(1u, 2u));
+}
+
+TEST(IngestConvertTest, AHistoryWithoutIdsIsOfItsNamedState) {
+  v1::IngestRequest request = History({5, 6});
+  request.mutable_history()->add_names("back door");
+  request.mutable_history()->add_groups("doors");
+  auto batch = BatchFromRequest(Generic(), request);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  const uint64_t id = storage::StateIdOfName("back door");
+  EXPECT_THAT(batch->keys, ElementsAre(id, id));
+  ASSERT_EQ(batch->labels.size(), 1u);
+  EXPECT_EQ(batch->labels[0].key, id);
+  EXPECT_EQ(batch->labels[0].group, "doors");
+  request.mutable_history()->set_names(0, "");
+  EXPECT_THAT(ErrorOf(Generic(), request), HasSubstr("history.names[0] is empty"));
+}
+
+TEST(IngestConvertTest, BadHistoriesNameTheField) {
+  v1::IngestRequest request = History({1, 2, NAN});
+  request.mutable_history()->add_ids(1);
+  EXPECT_THAT(ErrorOf(Generic(), request), HasSubstr("history.times[2]"));
+  request = History({1, 2, 3});
+  request.mutable_history()->add_ids(1);
+  request.mutable_history()->add_ids(2);
+  EXPECT_THAT(ErrorOf(Generic(), request), HasSubstr("history.ids has 2 ids for 3 values"));
+  request = History({1, 2});
+  request.mutable_history()->add_ids(1);
+  request.mutable_history()->add_values(0.0f);
+  EXPECT_THAT(ErrorOf(Generic(), request), HasSubstr("history.times has 2 times for 3 values"));
+  request = History({1});
+  request.mutable_history()->add_ids(1);
+  request.set_time(4);
+  EXPECT_THAT(ErrorOf(Generic(), request), HasSubstr("time must be 0"));
+  request = History({1});
+  request.mutable_history()->add_ids(1);
+  EXPECT_THAT(ErrorOf(Grid(4, 4, 1), request), HasSubstr("only for generic maps"));
+}
+
 TEST(IngestConvertTest, AcksAndErrorsBecomeResponses) {
   storage::BatchAck ack;
   ack.sequence = 9;

@@ -150,6 +150,30 @@ class IngestSession:
             request.points.values.extend(floats)
         return self._put(request, sequence)
 
+    def send_history(self, times: Iterable[float], values: Iterable[float], *, ids: Optional[Ids] = None,
+                     names: Optional[Names] = None, groups: Optional[Iterable[str]] = None,
+                     sequence: Optional[int] = None) -> int:
+        """Sends a history (generic maps): observations `values` (each in [0, 1]) each at its own
+        time in `times` (seconds) — a robot's log uploaded, a dataset imported — as one batch
+        instead of one per time. The states: exactly one of ids= / names=, either one per value or
+        a single one (one state's history, sent once); groups= optionally labels each of them. The
+        daemon applies it exactly as one scan per run of consecutive observations with the same
+        time, in the order given (so give a log in time order). Returns its sequence number."""
+        request = ingest_pb2.IngestRequest(map=self.map_name, writer_id=self.writer_id)
+        kind = refs.chosen_kind({"ids": ids, "names": names}, "send_history")
+        history = request.history
+        history.times.extend(float(t) for t in times)
+        history.values.extend(float(v) for v in values)
+        if kind == "ids":
+            assert ids is not None
+            history.ids.extend(int(i) for i in ids)
+        else:
+            assert names is not None
+            history.names.extend(names)
+        if groups is not None:
+            history.groups.extend(groups)
+        return self._put(request, sequence)
+
     def send_patch(self, time: float, origin: Sequence[int], size: Sequence[int], *, values: Optional[Any] = None,
                    probabilities: Optional[Union[bytes, bytearray, Sequence[int]]] = None,
                    sequence: Optional[int] = None) -> int:

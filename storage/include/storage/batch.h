@@ -1,5 +1,5 @@
-// A batch of observations: one time, many states (one robot scan), from one writer with a sequence
-// number. The unit of the write path: validated, logged, applied and acknowledged whole.
+// A batch of observations: one time, many states (one robot scan), or a history (a time per
+// observation: a robot's log, an imported dataset), from one writer with a sequence number. The unit of the write path: validated, logged, applied and acknowledged whole.
 //
 // States are given by key (storage/cell_key.h: Morton code of a grid cell, or a generic state's id)
 // or, for grids, as a dense patch (a box of cells, values x fastest, then y, then z). Generic states
@@ -56,6 +56,11 @@ struct ObservationBatch {
   } keys_from_grid;
   DensePatch patch;           // empty when size has a zero
   std::vector<StateLabel> labels;
+  // A history: empty for a scan (every observation at `time`), else one time per key, `time` 0 and
+  // no patch. Applied as one scan per run of consecutive keys with the same time, in order.
+  std::vector<double> times;
+
+  bool is_history() const { return !times.empty(); }
 
   size_t observation_count() const {
     return keys.size() + size_t{patch.size[0]} * patch.size[1] * patch.size[2];
@@ -99,7 +104,8 @@ inline constexpr size_t kMaxLabelLength = 256;
 absl::Status CheckTime(double t, absl::string_view field);
 
 // Checks what makes the whole batch unusable (the message names the field): the time (CheckTime), mismatched lengths, a patch outside the grid or with the wrong value count,
-// labels on a grid. Per-observation problems are not errors: see Classify.
+// labels on a grid; for a history also every time (CheckTime, "times[i]"), a time or a patch beside
+// the times, and a grid map (histories are for generic maps). Per-observation problems are not errors: see Classify.
 absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch);
 
 // Marks each observation accepted or rejected; `accept[i]` for i over keys then patch cells.
@@ -110,9 +116,10 @@ BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector
 absl::Status ExpandCompact(const MapInfo& map, ObservationBatch& batch);
 
 // Log payload encoding: version 2 when batch.compact is set (its bytes as they came, not keys and
-// values), version 1 otherwise, so that a batch of the other kinds keeps its bytes and fingerprint.
-// DecodeBatch reads both; a version 2 batch comes back with compact set and keys empty, for
-// ExpandCompact. Decode answers DataLoss on damaged bytes.
+// values), version 3 for a history (version 1's fields, then the times), version 1 otherwise, so
+// that a batch of the other kinds keeps its bytes and fingerprint. DecodeBatch reads all three; a
+// version 2 batch comes back with compact set and keys empty, for ExpandCompact. Decode answers
+// DataLoss on damaged bytes.
 std::string EncodeBatch(const ObservationBatch& batch);
 absl::StatusOr<ObservationBatch> DecodeBatch(std::string_view bytes);
 
