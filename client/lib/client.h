@@ -197,9 +197,12 @@ class Client {
                                                   const std::function<absl::StatusOr<bool>(v1::MapChunk&)>& next,
                                                   const CallOptions& call = {}) const;
   // ExportMap of `map` here streamed straight into ImportMap on `target`, as `new_name` (empty:
-  // the same name).
+  // the same name). An online move copies kind ONLINE_SNAPSHOT, then (writes stopped) kind TAIL
+  // after the snapshot's LSN (the first answer's snapshot_lsn) into the same name.
   absl::StatusOr<v1::ImportMapResponse> CopyMapTo(const Client& target, absl::string_view map,
-                                                  absl::string_view new_name = "", const CallOptions& call = {}) const;
+                                                  absl::string_view new_name = "", const CallOptions& call = {},
+                                                  v1::MapExportKind kind = v1::MAP_EXPORT_KIND_SNAPSHOT,
+                                                  uint64_t tail_after_lsn = 0) const;
   // A step of a move on the daemon that holds the map (AdminService.SetMapMove). Each step is
   // idempotent, so it is retried.
   absl::StatusOr<v1::SetMapMoveResponse> SetMapMove(absl::string_view map, v1::MapMoveStep step,

@@ -192,10 +192,13 @@ absl::StatusOr<v1::ImportMapResponse> Client::ImportMap(
 }
 
 absl::StatusOr<v1::ImportMapResponse> Client::CopyMapTo(const Client& target, absl::string_view map,
-                                                        absl::string_view new_name, const CallOptions& call) const {
+                                                        absl::string_view new_name, const CallOptions& call,
+                                                        v1::MapExportKind kind, uint64_t tail_after_lsn) const {
   const std::string name(new_name.empty() ? map : new_name);
   v1::ExportMapRequest request;
   request.set_map(std::string(map));
+  request.set_kind(kind);
+  request.set_tail_after_lsn(tail_after_lsn);
   auto context = connection_->NewContext(connection_->DeadlineOf(call), map);
   auto reader = connection_->admin().ExportMap(context.get(), request);
   bool ended = false;
