@@ -142,10 +142,13 @@ absl::StatusOr<v1::SalvageMapResponse> Client::SalvageMap(absl::string_view map,
 
 absl::Status Client::ExportMap(absl::string_view map,
                               const std::function<absl::Status(const v1::MapChunk&)>& receive,
-                              const CallOptions& call, uint32_t chunk_bytes) const {
+                              const CallOptions& call, uint32_t chunk_bytes, v1::MapExportKind kind,
+                              uint64_t tail_after_lsn) const {
   v1::ExportMapRequest request;
   request.set_map(std::string(map));
   request.set_chunk_bytes(chunk_bytes);
+  request.set_kind(kind);
+  request.set_tail_after_lsn(tail_after_lsn);
   absl::Status refused;
   absl::Status status = connection_->CallOnce(call, map, [&](grpc::ClientContext& context) {
     auto reader = connection_->admin().ExportMap(&context, request);
