@@ -65,6 +65,8 @@ struct Member {
   std::unique_ptr<FremendProcess> process;
 };
 
+class Traffic;
+
 class FleetRebalanceTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -154,6 +156,9 @@ class FleetRebalanceTest : public ::testing::Test {
     args.insert(args.end(), extra.begin(), extra.end());
     return args;
   }
+  // Starts the writers, waits for ten batches acknowledged on every map (their counts in
+  // `progress`), then starts the fourth daemon.
+  void StartTrafficThenTheFourthDaemon(Traffic& traffic, std::vector<uint64_t>& progress);
   // The member whose gRPC address is `address`.
   int MemberAt(const std::string& address) const {
     for (size_t d = 0; d < members_.size(); ++d) {
@@ -267,6 +272,12 @@ class Traffic {
   mutable base::Mutex mutex_;
   std::vector<std::string> failures_ ABSL_GUARDED_BY(mutex_);
 };
+
+void FleetRebalanceTest::StartTrafficThenTheFourthDaemon(Traffic& traffic, std::vector<uint64_t>& progress) {
+  ASSERT_TRUE(traffic.Start().ok());
+  progress = traffic.AwaitProgress(std::vector<uint64_t>(kMaps, 0), 10);
+  StartMember(kFirstDaemons);
+}
 
 // Every acknowledged observation of map i is at `owner`, once: its count there is exactly its
 // writer's acknowledged batches' (no batch lost or applied twice).
@@ -446,9 +457,8 @@ TEST_F(FleetRebalanceTest, WritesAreAcceptedWhileTheSnapshotsAreCopiedAndTheTail
   const std::set<std::string> moving = Moving();
   ASSERT_FALSE(moving.empty());
   Traffic traffic(proxy_->grpc_address());
-  ASSERT_TRUE(traffic.Start().ok());
-  std::vector<uint64_t> progress = traffic.AwaitProgress(std::vector<uint64_t>(kMaps, 0), 10);
-  StartMember(kFirstDaemons);
+  std::vector<uint64_t> progress;
+  StartTrafficThenTheFourthDaemon(traffic, progress);
   ASSERT_FALSE(HasFatalFailure());
 
   PausedRebalance run(RebalanceArgs(), dir_.Path("paused"));
@@ -491,9 +501,8 @@ TEST_F(FleetRebalanceTest, AKill9OfASourceMidMoveLosesNothingOnceTheRebalanceRun
   const std::set<std::string> moving = Moving();
   ASSERT_FALSE(moving.empty());
   Traffic traffic(proxy_->grpc_address());
-  ASSERT_TRUE(traffic.Start().ok());
-  std::vector<uint64_t> progress = traffic.AwaitProgress(std::vector<uint64_t>(kMaps, 0), 10);
-  StartMember(kFirstDaemons);
+  std::vector<uint64_t> progress;
+  StartTrafficThenTheFourthDaemon(traffic, progress);
   ASSERT_FALSE(HasFatalFailure());
 
   {

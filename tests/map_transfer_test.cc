@@ -140,6 +140,24 @@ v1::ReconstructResponse Reconstruct(const FremendProcess& daemon, const std::str
   return response;
 }
 
+// Writer kWriter's last batch of the hall (sequence kSlots) sent again: a duplicate wherever the
+// writer's window is the hall's.
+IngestTotals ResendLastHallBatch(const Client& client) {
+  IngestOptions options;
+  options.writer_id = kWriter;
+  options.first_sequence = kSlots;
+  auto session = client.OpenIngest("hall", options);
+  EXPECT_TRUE(session.ok()) << session.status();
+  if (!session.ok()) return {};
+  ScanBuilder last(kT0 + kDelta * (kSlots - 1));
+  for (uint32_t y = 0; y < kNy; ++y) {
+    for (uint32_t x = 0; x < kNx; ++x) last.AddCell({x, y, 0}, Open(kSlots - 1, x + kNx * y));
+  }
+  EXPECT_TRUE((*session)->Send(*last.Build()).ok());
+  EXPECT_TRUE((*session)->Close().ok());
+  return (*session)->totals();
+}
+
 TEST_F(MapTransferTest, AnImportedMapAnswersExactlyAsTheExportedOne) {
   const Client a = ClientOf(0), b = ClientOf(1);
   MakeHall(a);
@@ -193,18 +211,7 @@ TEST_F(MapTransferTest, AnImportedMapAnswersExactlyAsTheExportedOne) {
   }
 
   // The writer's window came along: where to continue, and a resent batch is a duplicate.
-  IngestOptions options;
-  options.writer_id = kWriter;
-  options.first_sequence = kSlots;  // the last batch again
-  auto session = b.OpenIngest("hall", options);
-  ASSERT_TRUE(session.ok());
-  ScanBuilder last(kT0 + kDelta * (kSlots - 1));
-  for (uint32_t y = 0; y < kNy; ++y) {
-    for (uint32_t x = 0; x < kNx; ++x) last.AddCell({x, y, 0}, Open(kSlots - 1, x + kNx * y));
-  }
-  ASSERT_TRUE((*session)->Send(*last.Build()).ok());
-  ASSERT_TRUE((*session)->Close().ok());
-  EXPECT_EQ((*session)->totals().duplicates, 1u);
+  EXPECT_EQ(ResendLastHallBatch(b).duplicates, 1u);
   EXPECT_EQ(b.GetMapStats("hall")->observations(), after->observations());
   ExpectNothingStaged(0);
   ExpectNothingStaged(1);
@@ -387,20 +394,7 @@ TEST_F(MapTransferTest, AnOnlineCopyTakesWritesDuringItsSnapshotAndItsTailCarrie
   const IngestTotals more = WriteMore(a, kWriter + 1, kMore);
   EXPECT_EQ(more.acknowledged, static_cast<uint64_t>(kMore));
   EXPECT_EQ(more.duplicates, 0u);
-  {
-    IngestOptions options;
-    options.writer_id = kWriter;
-    options.first_sequence = kSlots;
-    auto session = a.OpenIngest("hall", options);
-    ASSERT_TRUE(session.ok());
-    ScanBuilder last(kT0 + kDelta * (kSlots - 1));
-    for (uint32_t y = 0; y < kNy; ++y) {
-      for (uint32_t x = 0; x < kNx; ++x) last.AddCell({x, y, 0}, Open(kSlots - 1, x + kNx * y));
-    }
-    ASSERT_TRUE((*session)->Send(*last.Build()).ok());
-    ASSERT_TRUE((*session)->Close().ok());
-    EXPECT_EQ((*session)->totals().duplicates, 1u);
-  }
+  EXPECT_EQ(ResendLastHallBatch(a).duplicates, 1u);
   // The update job is refused while the map is copied (its publication cannot ride in a tail).
   EXPECT_EQ(a.RunUpdate("hall").status().code(), absl::StatusCode::kUnavailable);
   // The copy refuses writes, retryably, until its tail is applied — also after a kill -9.
