@@ -118,7 +118,7 @@ struct MapStats {
 // Where a map is in a move to another daemon (docs/fleet.md, "Moving a map").
 enum class MoveState {
   kServing,        // takes writes
-  kWritesStopped,  // a move is copying it: writes refused, until ResumeWrites or MarkMoved
+  kWritesStopped,  // a move copies its tail (or, offline, the map): writes refused, until ResumeWrites or MarkMoved
   kMoved,          // the move is committed: writes refused for good (kept across a reopen)
   kCopying,        // an online move copies its snapshot: takes writes, recording them (StartTail)
   kIncoming,       // a move's copy waiting for its tail (ApplyTail): refuses writes (kept across a reopen)
