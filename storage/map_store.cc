@@ -11,7 +11,10 @@
 #include <future>
 
 #include "absl/strings/cord.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
+#include "absl/strings/ascii.h"
 #include "absl/time/clock.h"
 #include "storage/cell_key.h"
 #include "storage/parallel_shards.h"
@@ -30,6 +33,8 @@ constexpr char kQueueFullPayload[] = "type.fremen/storage.QueueFull";
 std::string ShardDir(const std::string& dir, uint32_t i) { return absl::StrCat(dir, "/shard-", i); }
 std::string LastUpdatePath(const std::string& dir) { return dir + "/last_update"; }
 std::string MovedToPath(const std::string& dir) { return dir + "/moved_to"; }
+// An incoming copy's marker (MoveState::kIncoming): the snapshot's LSN, in decimal.
+std::string IncomingPath(const std::string& dir) { return dir + "/" + kIncomingFile; }
 
 absl::Status MakeDir(const std::string& dir) {
   if (mkdir(dir.c_str(), 0750) != 0 && errno != EEXIST) {
@@ -122,6 +127,18 @@ absl::StatusOr<std::unique_ptr<MapStoreImpl>> MapStoreImpl::Open(const MapInfo& 
   } else if (!absl::IsNotFound(to.status())) {
     return to.status();
   }
+  // A move's copy waiting for its tail stays so: it must not take writes before the batches the
+  // source acknowledged after its snapshot.
+  if (auto incoming = options.env->ReadFile(IncomingPath(dir)); incoming.ok()) {
+    uint64_t lsn = 0;
+    if (!absl::SimpleAtoi(absl::StripAsciiWhitespace(*incoming), &lsn)) {
+      return absl::DataLossError(absl::StrCat("map ", info.name, ": ", IncomingPath(dir), " does not hold an LSN"));
+    }
+    base::MutexLock lock(&store->queue_mutex_);
+    store->move_ = MoveStatus{MoveState::kIncoming, "", lsn};
+  } else if (!absl::IsNotFound(incoming.status())) {
+    return incoming.status();
+  }
   store->workers_ = std::make_unique<ShardWorkers>(info.shards, "fremen-shard");
   store->committer_ = std::thread([s = store.get()] { s->CommitLoop(); });
   store->applier_ = std::thread([s = store.get()] { s->ApplyLoop(); });
@@ -144,6 +161,7 @@ absl::Status MapStoreImpl::Recover() {
   for (const auto& shard : shards_) {
     from = std::min(from, shard->checkpoint_lsn());
     newest = std::max(newest, shard->checkpoint_lsn());
+    written_lsn_ = from;
     dedup_.MergeFrom(shard->checkpoint_dedup());
   }
   auto replayed = ReplayWal(dir_ + "/wal", from, [&](uint64_t lsn, std::span<const uint8_t> payload)
@@ -280,7 +298,7 @@ void MapStoreImpl::SplitByShard(Pending& pending) const {
   }
 }
 
-absl::Status MapStoreImpl::Submit(ObservationBatch batch, AckCallback done) {
+absl::Status MapStoreImpl::Enqueue(ObservationBatch batch, AckCallback done, bool tail) {
   if (absl::Status valid = ValidateBatch(info_, batch); !valid.ok()) return valid;
   if (info_.lossless_sampling_period > 0 && batch.time < info_.lossless_origin && !batch.is_history()) {
     return absl::InvalidArgumentError(absl::StrCat("time must not be before the map's lossless origin ",
@@ -298,8 +316,8 @@ absl::Status MapStoreImpl::Submit(ObservationBatch batch, AckCallback done) {
   const auto refusal = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(queue_mutex_) -> absl::Status {
     if (closing_) return absl::UnavailableError(absl::StrCat("map ", info_.name, " is closing"));
     if (!write_error_.ok()) return write_error_;
-    if (move_.state != MoveState::kServing) return MovingError(info_.name);
-    if (!FitsLocked(n)) {
+    if (tail ? move_.state != MoveState::kIncoming : !TakesWrites(move_.state)) return MovingError(info_.name);
+    if (!tail && !FitsLocked(n)) {
       absl::Status full = absl::ResourceExhaustedError(
           absl::StrCat("map ", info_.name, " is behind on ingest: too many queued observations; retry"));
       full.SetPayload(kQueueFullPayload, absl::Cord());
@@ -327,7 +345,7 @@ absl::Status MapStoreImpl::Submit(ObservationBatch batch, AckCallback done) {
 void MapStoreImpl::OnRoom(uint64_t observations, std::function<void()> f) {
   {
     base::MutexLock lock(&queue_mutex_);
-    if (!FitsLocked(observations) && !closing_ && write_error_.ok() && move_.state == MoveState::kServing) {
+    if (!FitsLocked(observations) && !closing_ && write_error_.ok() && TakesWrites(move_.state)) {
       room_waiters_.push_back(std::move(f));
       return;
     }
@@ -404,7 +422,10 @@ absl::Status MapStoreImpl::StopWrites() {
   std::vector<std::function<void()>> room;
   {
     base::MutexLock lock(&queue_mutex_);
-    if (move_.state == MoveState::kServing) move_.state = MoveState::kWritesStopped;
+    if (move_.state == MoveState::kIncoming) {
+      return absl::FailedPreconditionError(absl::StrCat("map ", info_.name, " is a move's copy waiting for its tail"));
+    }
+    if (TakesWrites(move_.state)) move_.state = MoveState::kWritesStopped;
     room.swap(room_waiters_);
   }
   // As after a latched error: waiters resubmit and learn that the map is moving.
@@ -419,7 +440,13 @@ absl::Status MapStoreImpl::ResumeWrites() {
     return absl::FailedPreconditionError(
         absl::StrCat("map ", info_.name, " has moved to ", move_.moved_to, "; delete this copy instead"));
   }
+  if (move_.state == MoveState::kIncoming) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("map ", info_.name, " is a move's copy waiting for its tail; delete it instead"));
+  }
   move_.state = MoveState::kServing;
+  base::MutexLock tail(&tail_mutex_);
+  tail_.reset();
   return absl::OkStatus();
 }
 
@@ -432,12 +459,123 @@ absl::Status MapStoreImpl::MarkMoved(const std::string& to) {
   }
   if (absl::Status s = WriteFileAtomically(options_.env, MovedToPath(dir_), to); !s.ok()) return s;
   move_ = MoveStatus{MoveState::kMoved, to};
+  base::MutexLock tail(&tail_mutex_);
+  tail_.reset();
   return absl::OkStatus();
 }
 
 MoveStatus MapStoreImpl::Move() const {
   base::MutexLock lock(&queue_mutex_);
   return move_;
+}
+
+absl::Status MapStoreImpl::StartTail() {
+  base::MutexLock lock(&queue_mutex_);
+  if (!TakesWrites(move_.state)) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("map ", info_.name, " does not take writes here (a move is under way or done): no copy starts"));
+  }
+  // Set under queue_mutex_, so that a PublishModels that saw the map serving has queued its
+  // request before this; its record then comes before the snapshot's checkpoint.
+  move_.state = MoveState::kCopying;
+  base::MutexLock tail(&tail_mutex_);
+  tail_.emplace();
+  return absl::OkStatus();
+}
+
+void MapStoreImpl::CaptureTail(uint64_t lsn, const std::string& record) {
+  base::MutexLock lock(&tail_mutex_);
+  if (!tail_ || !tail_->given_up.empty()) return;
+  tail_->bytes += record.size();
+  if (tail_->bytes > options_.max_tail_bytes) {
+    tail_->given_up = absl::StrCat("more than ", options_.max_tail_bytes, " bytes were written during the copy");
+    tail_->records.clear();
+    return;
+  }
+  // The record without its kind byte: the batch's EncodeBatch bytes.
+  tail_->records.push_back(TailRecord{lsn, record.substr(1)});
+}
+
+void MapStoreImpl::GiveUpTail(const std::string& why) {
+  base::MutexLock lock(&tail_mutex_);
+  if (!tail_ || !tail_->given_up.empty()) return;
+  tail_->given_up = why;
+  tail_->records.clear();
+}
+
+absl::StatusOr<std::vector<TailRecord>> MapStoreImpl::Tail(uint64_t after) const {
+  {
+    base::MutexLock lock(&queue_mutex_);
+    if (!write_error_.ok()) return write_error_;
+    if (move_.state != MoveState::kWritesStopped) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("map ", info_.name, ": its tail is sent once its writes are stopped (SetMapMove STOP_WRITES)"));
+    }
+  }
+  base::MutexLock lock(&tail_mutex_);
+  if (!tail_) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "map ", info_.name, " records no tail (no online copy was started since it opened): copy it again"));
+  }
+  if (!tail_->given_up.empty()) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("map ", info_.name, ": its tail was given up (", tail_->given_up, "): copy it again"));
+  }
+  std::vector<TailRecord> out;
+  for (const TailRecord& r : tail_->records) {
+    if (r.lsn > after) out.push_back(r);
+  }
+  return out;
+}
+
+absl::Status MapStoreImpl::ApplyTail(uint64_t after, std::span<const TailRecord> tail) {
+  {
+    base::MutexLock lock(&queue_mutex_);
+    if (move_.state != MoveState::kIncoming) {
+      return absl::FailedPreconditionError(absl::StrCat("map ", info_.name, " is not a move's copy waiting for its tail"));
+    }
+    if (move_.snapshot_lsn != after) {
+      return absl::FailedPreconditionError(absl::StrCat("map ", info_.name, "'s snapshot is at LSN ", move_.snapshot_lsn,
+                                                        "; the tail continues one at LSN ", after));
+    }
+  }
+  std::vector<std::future<absl::StatusOr<BatchAck>>> acks;
+  std::vector<std::shared_ptr<std::promise<absl::StatusOr<BatchAck>>>> promises;
+  for (const TailRecord& r : tail) {
+    auto batch = DecodeBatch(r.batch);
+    if (!batch.ok()) {
+      return absl::DataLossError(absl::StrCat("map ", info_.name, ": tail batch at LSN ", r.lsn, ": ",
+                                              batch.status().message()));
+    }
+    auto promise = std::make_shared<std::promise<absl::StatusOr<BatchAck>>>();
+    acks.push_back(promise->get_future());
+    if (absl::Status s = Enqueue(*std::move(batch), [promise](absl::StatusOr<BatchAck> ack) { promise->set_value(std::move(ack)); },
+                                 /*tail=*/true);
+        !s.ok()) {
+      for (size_t i = 0; i + 1 < acks.size(); ++i) acks[i].wait();
+      return absl::Status(s.code(), absl::StrCat("map ", info_.name, ": tail batch at LSN ", r.lsn, ": ", s.message()));
+    }
+  }
+  absl::Status status;
+  for (size_t i = 0; i < acks.size(); ++i) {
+    absl::StatusOr<BatchAck> ack = acks[i].get();
+    if (!status.ok()) continue;
+    if (!ack.ok()) {
+      status = ack.status();
+    } else if (ack->duplicate || !ack->error.ok()) {
+      // The snapshot had it already, or another batch under its (writer, sequence): the tail does
+      // not continue this snapshot, and the copy's deduplication windows would not be the source's.
+      status = absl::DataLossError(absl::StrCat("map ", info_.name, ": tail batch at LSN ", tail[i].lsn,
+                                                " does not follow the snapshot (",
+                                                ack->duplicate ? "applied already" : ack->error.message(), ")"));
+    }
+  }
+  if (!status.ok()) return status;
+  if (absl::Status s = Checkpoint(); !s.ok()) return s;
+  base::MutexLock lock(&queue_mutex_);
+  if (absl::Status s = options_.env->Unlink(IncomingPath(dir_)); !s.ok() && !absl::IsNotFound(s)) return s;
+  move_ = MoveStatus{};
+  return absl::OkStatus();
 }
 
 void MapStoreImpl::Latch(const absl::Status& status) {
@@ -495,6 +633,8 @@ void MapStoreImpl::CommitLoop() {
         if (c.kind != Control::Kind::kPublish) continue;
         const char record[] = {kPublishRecord};
         c.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(record), 1});
+        // A publication cannot be carried by a tail (batches only): a copy in progress is redone.
+        GiveUpTail("an update job published during the copy");
       }
       const absl::Time sync_start = absl::Now();
       status = wal_->Sync();
@@ -543,6 +683,7 @@ void MapStoreImpl::LogGroup(std::vector<Pending>& group) {
     }
     dedup_.Record(p.batch.writer_id, p.batch.sequence, p.fingerprint);
     p.ack.lsn = wal_->Append({reinterpret_cast<const uint8_t*>(p.record.data()), p.record.size()});
+    CaptureTail(p.ack.lsn, p.record);
   }
 }
 
@@ -718,6 +859,7 @@ absl::Status MapStoreImpl::WriteCheckpoint(uint64_t lsn, std::vector<Shard::Chec
     base::MutexLock wal(&wal_mutex_);
     status = wal_->DropThrough(lsn);
   }
+  if (status.ok()) written_lsn_ = lsn;
   // Reader slots of processes that died while reading (a backup tool, mdb_stat) would pin old
   // pages forever; clearing them with every checkpoint bounds the file's growth.
   for (const auto& shard : shards_) (void)shard->env().ClearStaleReaders();
@@ -885,11 +1027,12 @@ MapStats MapStoreImpl::Stats() const {
   return stats;
 }
 
-absl::StatusOr<uint64_t> MapStoreImpl::Backup(const std::string& dir) {
+absl::StatusOr<uint64_t> MapStoreImpl::Backup(const std::string& dir, uint64_t* lsn) {
   if (absl::Status s = MakeDir(dir); !s.ok()) return s;
   if (absl::Status s = Checkpoint(); !s.ok()) return s;
   // No checkpoint can run while this is held, so every shard's copy is at the same log position.
   base::MutexLock backup(&backup_mutex_);
+  if (lsn != nullptr) *lsn = written_lsn_;
   for (uint32_t i = 0; i < shards_.size(); ++i) {
     if (absl::Status s = shards_[i]->env().CopyTo(ShardDir(dir, i)); !s.ok()) return s;
   }

@@ -35,7 +35,9 @@ class MapStoreImpl final : public MapStore {
   const MapInfo& info() const override { return info_; }
   const model::ModelSettings& settings() const override { return *settings_; }
 
-  absl::Status Submit(ObservationBatch batch, AckCallback done) override ABSL_LOCKS_EXCLUDED(queue_mutex_);
+  absl::Status Submit(ObservationBatch batch, AckCallback done) override ABSL_LOCKS_EXCLUDED(queue_mutex_) {
+    return Enqueue(std::move(batch), std::move(done), /*tail=*/false);
+  }
   absl::StatusOr<BatchAck> Write(ObservationBatch batch) override;
   void OnRoom(uint64_t observations, std::function<void()> f) override ABSL_LOCKS_EXCLUDED(queue_mutex_);
   uint64_t LastSequence(uint64_t writer) const override ABSL_LOCKS_EXCLUDED(dedup_mutex_);
@@ -48,6 +50,10 @@ class MapStoreImpl final : public MapStore {
   absl::Status ResumeWrites() override ABSL_LOCKS_EXCLUDED(queue_mutex_);
   absl::Status MarkMoved(const std::string& to) override ABSL_LOCKS_EXCLUDED(queue_mutex_);
   MoveStatus Move() const override ABSL_LOCKS_EXCLUDED(queue_mutex_);
+  absl::Status StartTail() override ABSL_LOCKS_EXCLUDED(queue_mutex_, tail_mutex_);
+  absl::StatusOr<std::vector<TailRecord>> Tail(uint64_t after) const override
+      ABSL_LOCKS_EXCLUDED(queue_mutex_, tail_mutex_);
+  absl::Status ApplyTail(uint64_t after, std::span<const TailRecord> tail) override ABSL_LOCKS_EXCLUDED(queue_mutex_);
 
   std::vector<float> Predict(std::span<const uint64_t> keys, std::span<const double> times,
                              const PredictOptions& options) const override;
@@ -66,7 +72,8 @@ class MapStoreImpl final : public MapStore {
                                                                const PredictOptions& options) const override
       ABSL_LOCKS_EXCLUDED(groups_mutex_);
   MapStats Stats() const override ABSL_LOCKS_EXCLUDED(last_update_mutex_);
-  absl::StatusOr<uint64_t> Backup(const std::string& dir) override ABSL_LOCKS_EXCLUDED(backup_mutex_);
+  absl::StatusOr<uint64_t> Backup(const std::string& dir, uint64_t* lsn = nullptr) override
+      ABSL_LOCKS_EXCLUDED(backup_mutex_);
   VerifyReport Verify(absl::Time deadline = absl::InfiniteFuture()) override ABSL_LOCKS_EXCLUDED(backup_mutex_);
 
  private:
@@ -107,6 +114,18 @@ class MapStoreImpl final : public MapStore {
     bool final = false;             // the map is closing: checkpoint and stop
   };
 
+  // A move's tail recorded while its snapshot is copied (StartTail).
+  struct TailCapture {
+    std::vector<TailRecord> records;
+    uint64_t bytes = 0;
+    std::string given_up;  // why the tail cannot be used, when not empty
+  };
+
+  // Submit; a move's tail (ApplyTail) is let into an incoming copy, past the queue's bound.
+  absl::Status Enqueue(ObservationBatch batch, AckCallback done, bool tail) ABSL_LOCKS_EXCLUDED(queue_mutex_);
+  // Records a logged batch (or gives the tail up for a publication) while a tail is captured.
+  void CaptureTail(uint64_t lsn, const std::string& record) ABSL_LOCKS_EXCLUDED(tail_mutex_);
+  void GiveUpTail(const std::string& why) ABSL_LOCKS_EXCLUDED(tail_mutex_);
   MapStoreImpl(MapInfo info, std::string dir, StoreOptions options, std::unique_ptr<model::ModelSettings> settings);
   // Not analysed: Open and Recover fill the guarded members before the store is shared (its
   // threads start last), when there is nothing to lock against.
@@ -195,8 +214,13 @@ class MapStoreImpl final : public MapStore {
   // A move (StopWrites, MarkMoved): writes refused while not kServing.
   MoveStatus move_ ABSL_GUARDED_BY(queue_mutex_);
 
-  // Guards no member: held by checkpoints and backups, so that a backup sees one checkpoint.
+  // Held by checkpoints and backups, so that a backup sees one checkpoint.
   base::Mutex backup_mutex_;
+  // The log position of the checkpoint on disk (every shard's), which a backup copies.
+  uint64_t written_lsn_ ABSL_GUARDED_BY(backup_mutex_) = 0;
+
+  mutable base::Mutex tail_mutex_;
+  std::optional<TailCapture> tail_ ABSL_GUARDED_BY(tail_mutex_);
 
   mutable base::Mutex last_update_mutex_;
   std::optional<UpdateRecord> last_update_ ABSL_GUARDED_BY(last_update_mutex_);

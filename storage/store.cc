@@ -183,14 +183,14 @@ absl::Status Store::DeleteMap(const std::string& name) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<uint64_t> Store::BackupMap(const std::string& name, const std::string& dir) {
+absl::StatusOr<uint64_t> Store::BackupMap(const std::string& name, const std::string& dir, uint64_t* lsn) {
   auto map = Map(name);
   if (!map.ok()) return map.status();
   std::error_code error;
   if (fs::exists(dir, error) && !fs::is_empty(dir, error)) {
     return absl::AlreadyExistsError(absl::StrCat("backup directory ", dir, " is not empty"));
   }
-  return (*map)->Backup(dir);
+  return (*map)->Backup(dir, lsn);
 }
 
 absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::string& name, absl::Time deadline) {
@@ -233,6 +233,8 @@ absl::StatusOr<MapInfo> Store::RestoreMap(const std::string& dir, const std::str
   }
   // Only a report (the last update job's record): a backup without one restores without one.
   if (!error && fs::exists(dir + "/last_update")) fs::copy_file(dir + "/last_update", target + "/last_update", error);
+  const std::string incoming = absl::StrCat("/", kIncomingFile);
+  if (!error && fs::exists(dir + incoming)) fs::copy_file(dir + incoming, target + incoming, error);
   if (error) {
     (void)catalog_->Delete(created->name);
     std::error_code ignored;

@@ -13,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -62,6 +64,8 @@ struct Member {
   std::string grpc, http, data_dir;
   std::unique_ptr<FremendProcess> process;
 };
+
+class Traffic;
 
 class FleetRebalanceTest : public ::testing::Test {
  protected:
@@ -142,6 +146,25 @@ class FleetRebalanceTest : public ::testing::Test {
       if (before_->Owner(MapName(i)) != after_->Owner(MapName(i))) moving.insert(MapName(i));
     }
     return moving;
+  }
+
+  // The rebalance onto the fourth daemon, reconfiguring nginx, with `extra` arguments.
+  std::vector<std::string> RebalanceArgs(const std::vector<std::string>& extra = {}) const {
+    std::vector<std::string> args = {"fleet", "rebalance", "--daemons", absl::StrJoin(Names(kFirstDaemons + 1), ","),
+                                     "--proxy-command", proxy_->ReloadCommand(Proxied(kFirstDaemons + 1)), "--proxy",
+                                     proxy_->grpc_address()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  }
+  // Starts the writers, waits for ten batches acknowledged on every map (their counts in
+  // `progress`), then starts the fourth daemon.
+  void StartTrafficThenTheFourthDaemon(Traffic& traffic, std::vector<uint64_t>& progress);
+  // The member whose gRPC address is `address`.
+  int MemberAt(const std::string& address) const {
+    for (size_t d = 0; d < members_.size(); ++d) {
+      if (members_[d].grpc == address) return static_cast<int>(d);
+    }
+    return -1;
   }
 
   TempDir dir_;
@@ -250,6 +273,31 @@ class Traffic {
   std::vector<std::string> failures_ ABSL_GUARDED_BY(mutex_);
 };
 
+void FleetRebalanceTest::StartTrafficThenTheFourthDaemon(Traffic& traffic, std::vector<uint64_t>& progress) {
+  ASSERT_TRUE(traffic.Start().ok());
+  progress = traffic.AwaitProgress(std::vector<uint64_t>(kMaps, 0), 10);
+  StartMember(kFirstDaemons);
+}
+
+// Every acknowledged observation of map i is at `owner`, once: its count there is exactly its
+// writer's acknowledged batches' (no batch lost or applied twice).
+void ExpectAcknowledgedAt(const Traffic& traffic, int i, const std::string& owner, bool moved) {
+  const std::string map = MapName(i);
+  const IngestSession& session = traffic.session(i);
+  EXPECT_EQ(session.totals().acknowledged, session.totals().sent) << map;
+  EXPECT_EQ(session.unacknowledged(), 0u) << map;
+  // A moved map's writer was told to retry (its stream ended) and resent to the new owner.
+  if (moved) {
+    EXPECT_GE(session.totals().reconnects, 1u) << map;
+  }
+  auto stats = ClientOf(owner, 4).GetMapStats(map);
+  ASSERT_TRUE(stats.ok()) << map << " at " << owner << ": " << stats.status();
+  // Each acknowledged batch (5 observations) applied exactly once: a duplicate's ack (a resend of a
+  // batch whose first ack was lost, as on a kill -9) accepts nothing because it was applied before.
+  EXPECT_EQ(stats->observations(), 5 * session.totals().acknowledged) << map << (moved ? " (moved)" : "");
+  EXPECT_EQ(session.totals().accepted, 5 * (session.totals().acknowledged - session.totals().duplicates)) << map;
+}
+
 TEST_F(FleetRebalanceTest, AFourthDaemonTakesExactlyTheMapsItNowOwnsWhileWritersKeepSending) {
   const std::set<std::string> moving = Moving();
   ASSERT_FALSE(moving.empty()) << "30 maps over 4 daemons: some move to the new one";
@@ -296,15 +344,8 @@ TEST_F(FleetRebalanceTest, AFourthDaemonTakesExactlyTheMapsItNowOwnsWhileWriters
         EXPECT_EQ(held[d].at(map).create_time().seconds(), initial[d].at(map).create_time().seconds()) << map;
       }
     }
-    const IngestSession& session = traffic.session(i);
-    EXPECT_EQ(session.totals().acknowledged, session.totals().sent) << map;
-    EXPECT_EQ(session.unacknowledged(), 0u) << map;
-    // A moved map's writer was told to retry (its stream ended) and resent to the new owner.
-    if (moving.contains(map)) EXPECT_GE(session.totals().reconnects, 1u) << map;
-    auto stats = ClientOf(owner, 4).GetMapStats(map);
-    ASSERT_TRUE(stats.ok()) << map << " at " << owner << ": " << stats.status();
-    EXPECT_EQ(stats->observations(), session.totals().accepted) << map << (moving.contains(map) ? " (moved)" : "");
-    EXPECT_EQ(session.totals().accepted, 5 * (session.totals().acknowledged - session.totals().duplicates)) << map;
+    ExpectAcknowledgedAt(traffic, i, owner, moving.contains(map));
+    if (HasFatalFailure()) return;
   }
   // Nothing is misplaced, and a second run has nothing to do.
   const RunResult placed = FremenctlReadOnly({"fleet", "placement", "--address", daemons});
@@ -364,6 +405,144 @@ TEST_F(FleetRebalanceTest, ARebalanceStoppedBeforeTheProxyIsFinishedByRunningItA
     auto got = proxy.GetMap(map);
     ASSERT_TRUE(got.ok()) << map << ": " << got.status();
     EXPECT_EQ(got->move_state(), v1::MAP_MOVE_STATE_SERVING) << map;
+  }
+}
+
+// A rebalance run on a thread that stops once its snapshots are copied (--test-pause-after-snapshot):
+// Paused() waits until it is there (or has ended: false), Finish() lets it go on and returns how it
+// ended.
+class PausedRebalance {
+ public:
+  PausedRebalance(std::vector<std::string> args, const std::string& pause_file) : pause_(pause_file) {
+    args.push_back("--test-pause-after-snapshot");
+    args.push_back(pause_file);
+    thread_ = std::thread([this, args] {
+      RunOptions options;
+      options.timeout = std::chrono::minutes(5);
+      result_ = RunProgram(FREMENCTL_BINARY, args, options);
+      ended_ = true;
+    });
+  }
+  ~PausedRebalance() { (void)Finish(); }
+
+  // Waits for the state, not for a time: the file appears once every snapshot is on its target.
+  bool Paused() const {
+    while (!std::filesystem::exists(pause_) && !ended_) absl::SleepFor(absl::Milliseconds(20));
+    return std::filesystem::exists(pause_);
+  }
+  const RunResult& Finish() {
+    std::error_code ignored;
+    std::filesystem::remove(pause_, ignored);
+    if (thread_.joinable()) thread_.join();
+    return result_;
+  }
+
+ private:
+  const std::string pause_;
+  std::thread thread_;
+  std::atomic<bool> ended_{false};
+  RunResult result_;
+};
+
+// The number in "copied the tail of MAP to ... (N batches", or -1 when the output has no such line.
+long TailBatches(const std::string& out, const std::string& map) {
+  const std::string prefix = absl::StrCat("copied the tail of ", map, " to ");
+  const size_t at = out.find(prefix);
+  if (at == std::string::npos) return -1;
+  const size_t open = out.find('(', at);
+  return open == std::string::npos ? -1 : std::strtol(out.c_str() + open + 1, nullptr, 10);
+}
+
+TEST_F(FleetRebalanceTest, WritesAreAcceptedWhileTheSnapshotsAreCopiedAndTheTailsCarryThem) {
+  const std::set<std::string> moving = Moving();
+  ASSERT_FALSE(moving.empty());
+  Traffic traffic(proxy_->grpc_address());
+  std::vector<uint64_t> progress;
+  StartTrafficThenTheFourthDaemon(traffic, progress);
+  ASSERT_FALSE(HasFatalFailure());
+
+  PausedRebalance run(RebalanceArgs(), dir_.Path("paused"));
+  if (!run.Paused()) FAIL() << "the rebalance ended before its pause: " << run.Finish().out << run.Finish().err;
+  // Every snapshot is on the new daemon, waiting for its tail; the sources take writes meanwhile.
+  const std::vector<std::map<std::string, v1::Map>> held = HeldMaps(kFirstDaemons + 1);
+  for (const std::string& map : moving) {
+    const int source = MemberAt(before_->Owner(map));
+    ASSERT_GE(source, 0);
+    EXPECT_EQ(held[source].at(map).move_state(), v1::MAP_MOVE_STATE_COPYING) << map;
+    ASSERT_TRUE(held[kFirstDaemons].contains(map)) << map;
+    EXPECT_EQ(held[kFirstDaemons].at(map).move_state(), v1::MAP_MOVE_STATE_INCOMING) << map;
+  }
+  // Ten more batches acknowledged on every map — the moving ones' by their sources, where the
+  // proxy still routes them — while the snapshots are copied already.
+  for (int i = 0; i < kMaps; ++i) progress[i] = traffic.Acknowledged(i);
+  traffic.AwaitProgress(progress, 10);
+  for (const std::string& map : moving) {
+    auto at_source = ClientOf(before_->Owner(map), 4).GetMapStats(map);
+    auto in_snapshot = ClientOf(members_[kFirstDaemons].grpc, 4).GetMapStats(map);
+    ASSERT_TRUE(at_source.ok() && in_snapshot.ok()) << map;
+    EXPECT_GT(at_source->observations(), in_snapshot->observations()) << map;
+  }
+
+  const RunResult& rebalance = run.Finish();
+  ASSERT_EQ(rebalance.exit_code, 0) << rebalance.out << rebalance.err << proxy_->ErrorLog();
+  // Each tail carried the batches acknowledged during the pause (and before the writes stopped).
+  for (const std::string& map : moving) EXPECT_GE(TailBatches(rebalance.out, map), 10) << map << "\n" << rebalance.out;
+  for (int i = 0; i < kMaps; ++i) progress[i] = traffic.Acknowledged(i);
+  traffic.AwaitProgress(progress, 10);
+  traffic.Stop();
+  EXPECT_THAT(traffic.failures(), ::testing::IsEmpty());
+  for (int i = 0; i < kMaps; ++i) {
+    ExpectAcknowledgedAt(traffic, i, after_->Owner(MapName(i)), moving.contains(MapName(i)));
+    if (HasFatalFailure()) return;
+  }
+}
+
+TEST_F(FleetRebalanceTest, AKill9OfASourceMidMoveLosesNothingOnceTheRebalanceRunsAgain) {
+  const std::set<std::string> moving = Moving();
+  ASSERT_FALSE(moving.empty());
+  Traffic traffic(proxy_->grpc_address());
+  std::vector<uint64_t> progress;
+  StartTrafficThenTheFourthDaemon(traffic, progress);
+  ASSERT_FALSE(HasFatalFailure());
+
+  {
+    PausedRebalance run(RebalanceArgs(), dir_.Path("paused"));
+    if (!run.Paused()) FAIL() << "the rebalance ended before its pause: " << run.Finish().out << run.Finish().err;
+    // kill -9 of a source between its snapshots and their tails, its writers sending; it restarts.
+    const int victim = MemberAt(before_->Owner(*moving.begin()));
+    ASSERT_GE(victim, 0);
+    members_[victim].process->Kill();
+    StartMember(victim);
+    ASSERT_FALSE(HasFatalFailure());
+    // The restarted source has no record of what was written since its snapshots: those tails
+    // cannot be sent, so the run gives every copy up and the maps stay where they were.
+    const RunResult& first = run.Finish();
+    EXPECT_EQ(first.exit_code, 1) << first.out << first.err;
+    EXPECT_THAT(first.err, HasSubstr("nothing was moved"));
+  }
+  const std::vector<std::map<std::string, v1::Map>> held = HeldMaps(kFirstDaemons + 1);
+  EXPECT_THAT(held[kFirstDaemons], ::testing::IsEmpty());
+  for (int i = 0; i < kMaps; ++i) {
+    const int source = MemberAt(before_->Owner(MapName(i)));
+    ASSERT_TRUE(held[source].contains(MapName(i))) << MapName(i);
+    EXPECT_EQ(held[source].at(MapName(i)).move_state(), v1::MAP_MOVE_STATE_SERVING) << MapName(i);
+  }
+
+  const RunResult second = Fremenctl(RebalanceArgs());
+  ASSERT_EQ(second.exit_code, 0) << second.out << second.err << proxy_->ErrorLog();
+  EXPECT_THAT(second.out, HasSubstr(absl::StrCat("moved ", moving.size(), " maps")));
+  for (int i = 0; i < kMaps; ++i) progress[i] = traffic.Acknowledged(i);
+  traffic.AwaitProgress(progress, 10);
+  traffic.Stop();
+  EXPECT_THAT(traffic.failures(), ::testing::IsEmpty());
+  const std::vector<std::map<std::string, v1::Map>> after = HeldMaps(kFirstDaemons + 1);
+  for (int i = 0; i < kMaps; ++i) {
+    const std::string map = MapName(i);
+    for (int d = 0; d <= kFirstDaemons; ++d) {
+      EXPECT_EQ(after[d].count(map), members_[d].grpc == after_->Owner(map) ? 1u : 0u) << map << " on " << d;
+    }
+    ExpectAcknowledgedAt(traffic, i, after_->Owner(map), moving.contains(map));
+    if (HasFatalFailure()) return;
   }
 }
 

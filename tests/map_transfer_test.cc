@@ -15,6 +15,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "client/lib/client.h"
+#include "fremen/v1/ingest.grpc.pb.h"
 #include "fremen/v1/query.grpc.pb.h"
 #include "tests/fremend_fixture.h"
 #include "tests/map_specs.h"
@@ -25,6 +26,7 @@ namespace {
 using ::fremen::client::Client;
 using ::fremen::client::ConnectionOptions;
 using ::fremen::client::IngestOptions;
+using ::fremen::client::IngestTotals;
 using ::fremen::client::ScanBuilder;
 using ::testing::HasSubstr;
 
@@ -138,6 +140,24 @@ v1::ReconstructResponse Reconstruct(const FremendProcess& daemon, const std::str
   return response;
 }
 
+// Writer kWriter's last batch of the hall (sequence kSlots) sent again: a duplicate wherever the
+// writer's window is the hall's.
+IngestTotals ResendLastHallBatch(const Client& client) {
+  IngestOptions options;
+  options.writer_id = kWriter;
+  options.first_sequence = kSlots;
+  auto session = client.OpenIngest("hall", options);
+  EXPECT_TRUE(session.ok()) << session.status();
+  if (!session.ok()) return {};
+  ScanBuilder last(kT0 + kDelta * (kSlots - 1));
+  for (uint32_t y = 0; y < kNy; ++y) {
+    for (uint32_t x = 0; x < kNx; ++x) last.AddCell({x, y, 0}, Open(kSlots - 1, x + kNx * y));
+  }
+  EXPECT_TRUE((*session)->Send(*last.Build()).ok());
+  EXPECT_TRUE((*session)->Close().ok());
+  return (*session)->totals();
+}
+
 TEST_F(MapTransferTest, AnImportedMapAnswersExactlyAsTheExportedOne) {
   const Client a = ClientOf(0), b = ClientOf(1);
   MakeHall(a);
@@ -191,18 +211,7 @@ TEST_F(MapTransferTest, AnImportedMapAnswersExactlyAsTheExportedOne) {
   }
 
   // The writer's window came along: where to continue, and a resent batch is a duplicate.
-  IngestOptions options;
-  options.writer_id = kWriter;
-  options.first_sequence = kSlots;  // the last batch again
-  auto session = b.OpenIngest("hall", options);
-  ASSERT_TRUE(session.ok());
-  ScanBuilder last(kT0 + kDelta * (kSlots - 1));
-  for (uint32_t y = 0; y < kNy; ++y) {
-    for (uint32_t x = 0; x < kNx; ++x) last.AddCell({x, y, 0}, Open(kSlots - 1, x + kNx * y));
-  }
-  ASSERT_TRUE((*session)->Send(*last.Build()).ok());
-  ASSERT_TRUE((*session)->Close().ok());
-  EXPECT_EQ((*session)->totals().duplicates, 1u);
+  EXPECT_EQ(ResendLastHallBatch(b).duplicates, 1u);
   EXPECT_EQ(b.GetMapStats("hall")->observations(), after->observations());
   ExpectNothingStaged(0);
   ExpectNothingStaged(1);
@@ -333,6 +342,154 @@ TEST_F(MapTransferTokenTest, AReadTokenMayNeitherExportNorImportNorMove) {
   EXPECT_EQ(reader.SetMapMove("lab", v1::MAP_MOVE_STEP_STOP_WRITES).status().code(),
             absl::StatusCode::kPermissionDenied);
   EXPECT_TRUE(Import(writer, "lab-copy", chunks).ok());
+}
+
+// LastSequence asked of one daemon directly: where the writer continues, or the refusal of a map
+// that takes no writes.
+absl::StatusOr<uint64_t> LastSequenceOn(const FremendProcess& daemon, const std::string& map, uint64_t writer) {
+  auto ingest = v1::IngestService::NewStub(daemon.NewChannel());
+  v1::LastSequenceRequest request;
+  request.set_map(map);
+  request.set_writer_id(writer);
+  v1::LastSequenceResponse response;
+  const grpc::Status status = ingest->LastSequence(CallContext().get(), request, &response);
+  if (!status.ok()) return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+  return response.last_sequence();
+}
+
+// Sends `count` one-cell batches as writer `writer`, each after the hall's slots: the same batches
+// every time, under sequences from 1 when first_sequence is 1 (a resend), else after the writer's
+// last one.
+IngestTotals WriteMore(const Client& client, uint64_t writer, int count, uint64_t first_sequence = 0) {
+  IngestOptions options;
+  options.writer_id = writer;
+  options.first_sequence = first_sequence;
+  options.reconnect_timeout = absl::ZeroDuration();
+  auto session = client.OpenIngest("hall", options);
+  EXPECT_TRUE(session.ok()) << session.status();
+  if (!session.ok()) return {};
+  for (int i = 0; i < count; ++i) {
+    const uint32_t cell = static_cast<uint32_t>(i) % kNx;
+    EXPECT_TRUE((*session)->Send(*ScanBuilder(kT0 + kDelta * (kSlots + i)).AddCell({cell, 1, 0}, i % 2).Build()).ok());
+  }
+  EXPECT_TRUE((*session)->Close().ok());
+  return (*session)->totals();
+}
+
+TEST_F(MapTransferTest, AnOnlineCopyTakesWritesDuringItsSnapshotAndItsTailCarriesThemExactly) {
+  const Client a = ClientOf(0);
+  MakeHall(a);
+  if (HasFatalFailure()) return;
+  auto snapshot = a.CopyMapTo(ClientOf(1), "hall", "", {}, v1::MAP_EXPORT_KIND_ONLINE_SNAPSHOT);
+  ASSERT_TRUE(snapshot.ok()) << snapshot.status();
+  EXPECT_GT(snapshot->snapshot_lsn(), 0u);
+  EXPECT_EQ(snapshot->map().move_state(), v1::MAP_MOVE_STATE_INCOMING);
+  EXPECT_EQ(a.GetMap("hall")->move_state(), v1::MAP_MOVE_STATE_COPYING);
+  const uint64_t in_snapshot = ClientOf(1).GetMapStats("hall")->observations();
+  EXPECT_EQ(in_snapshot, static_cast<uint64_t>(kSlots) * kNx * kNy);
+
+  // The source takes writes meanwhile, acknowledged as usual: a second writer's, and a resend of
+  // the first writer's last batch (a duplicate: not applied, and not in the tail).
+  constexpr int kMore = 25;
+  const IngestTotals more = WriteMore(a, kWriter + 1, kMore);
+  EXPECT_EQ(more.acknowledged, static_cast<uint64_t>(kMore));
+  EXPECT_EQ(more.duplicates, 0u);
+  EXPECT_EQ(ResendLastHallBatch(a).duplicates, 1u);
+  // The update job is refused while the map is copied (its publication cannot ride in a tail).
+  EXPECT_EQ(a.RunUpdate("hall").status().code(), absl::StatusCode::kUnavailable);
+  // The copy refuses writes, retryably, until its tail is applied — also after a kill -9.
+  EXPECT_EQ(LastSequenceOn(*daemons_[1], "hall", kWriter).status().code(), absl::StatusCode::kUnavailable);
+  daemons_[1]->Kill();
+  auto restarted = FremendProcess::Start(dir_.Path("daemon-1"), args_);
+  ASSERT_TRUE(restarted.ok()) << restarted.status();
+  daemons_[1] = *std::move(restarted);
+  const Client b = ClientOf(1);
+  EXPECT_EQ(b.GetMap("hall")->move_state(), v1::MAP_MOVE_STATE_INCOMING);
+  EXPECT_EQ(LastSequenceOn(*daemons_[1], "hall", kWriter).status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_EQ(b.GetMapStats("hall")->observations(), in_snapshot);
+
+  ASSERT_TRUE(a.SetMapMove("hall", v1::MAP_MOVE_STEP_STOP_WRITES).ok());
+  const uint64_t at_source = a.GetMapStats("hall")->observations();
+  EXPECT_EQ(at_source, in_snapshot + kMore);
+  auto tail = a.CopyMapTo(b, "hall", "", {}, v1::MAP_EXPORT_KIND_TAIL, snapshot->snapshot_lsn());
+  ASSERT_TRUE(tail.ok()) << tail.status();
+  EXPECT_EQ(tail->tail_batches(), static_cast<uint64_t>(kMore));
+  EXPECT_EQ(tail->map().move_state(), v1::MAP_MOVE_STATE_SERVING);
+  EXPECT_EQ(b.GetMapStats("hall")->observations(), at_source);
+  // The writers' windows are the source's: where each continues, and a resend is a duplicate.
+  EXPECT_EQ(LastSequenceOn(*daemons_[1], "hall", kWriter).value_or(0), static_cast<uint64_t>(kSlots));
+  EXPECT_EQ(LastSequenceOn(*daemons_[1], "hall", kWriter + 1).value_or(0), static_cast<uint64_t>(kMore));
+  const IngestTotals again = WriteMore(b, kWriter + 1, kMore, /*first_sequence=*/1);  // the tail's batches resent
+  EXPECT_EQ(again.acknowledged, static_cast<uint64_t>(kMore));
+  EXPECT_EQ(again.duplicates, static_cast<uint64_t>(kMore));
+  EXPECT_EQ(b.GetMapStats("hall")->observations(), at_source);
+  ExpectNothingStaged(0);
+  ExpectNothingStaged(1);
+}
+
+TEST_F(MapTransferTest, ADamagedTailIsDataLossAndLeavesTheTargetWithoutTheMap) {
+  const Client a = ClientOf(0), b = ClientOf(1);
+  MakeHall(a);
+  if (HasFatalFailure()) return;
+  // A snapshot copied online, three batches after it, writes stopped: the tail to send.
+  const auto snapshot_and_tail = [&](std::vector<v1::MapChunk>& tail) -> uint64_t {
+    auto resumed = a.SetMapMove("hall", v1::MAP_MOVE_STEP_RESUME_WRITES);
+    EXPECT_TRUE(resumed.ok()) << resumed.status();
+    auto snapshot = a.CopyMapTo(b, "hall", "", {}, v1::MAP_EXPORT_KIND_ONLINE_SNAPSHOT);
+    EXPECT_TRUE(snapshot.ok()) << snapshot.status();
+    if (!snapshot.ok()) return 0;
+    WriteMore(a, kWriter + 1 + snapshot->snapshot_lsn(), 3);
+    EXPECT_TRUE(a.SetMapMove("hall", v1::MAP_MOVE_STEP_STOP_WRITES).ok());
+    tail.clear();
+    const absl::Status exported = a.ExportMap(
+        "hall",
+        [&](const v1::MapChunk& chunk) {
+          tail.push_back(chunk);
+          return absl::OkStatus();
+        },
+        {}, 0, v1::MAP_EXPORT_KIND_TAIL, snapshot->snapshot_lsn());
+    EXPECT_TRUE(exported.ok()) << exported;
+    return snapshot->snapshot_lsn();
+  };
+  std::vector<v1::MapChunk> tail;
+  snapshot_and_tail(tail);
+  ASSERT_EQ(tail.size(), 5u) << "header, three batches, trailer";
+  ASSERT_TRUE(tail[2].has_batch());
+  std::string& bytes = *tail[2].mutable_batch()->mutable_batch();
+  bytes[bytes.size() / 2] ^= 0x10;
+  auto damaged = Import(b, "hall", tail);
+  EXPECT_EQ(damaged.status().code(), absl::StatusCode::kDataLoss) << damaged.status();
+  EXPECT_THAT(damaged.status().message(), HasSubstr("checksum mismatch"));
+  EXPECT_TRUE(MapNames(1).empty()) << "the incoming copy is deleted with its damaged tail";
+
+  snapshot_and_tail(tail);
+  tail.erase(tail.begin() + 2);  // a batch lost on the way
+  auto skipped = Import(b, "hall", tail);
+  EXPECT_EQ(skipped.status().code(), absl::StatusCode::kDataLoss) << skipped.status();
+  EXPECT_TRUE(MapNames(1).empty());
+
+  snapshot_and_tail(tail);
+  tail.pop_back();  // torn before the trailer
+  auto torn = Import(b, "hall", tail);
+  EXPECT_EQ(torn.status().code(), absl::StatusCode::kDataLoss) << torn.status();
+  EXPECT_THAT(torn.status().message(), HasSubstr("before its trailer"));
+  EXPECT_TRUE(MapNames(1).empty());
+
+  // A tail of another snapshot does not continue this one.
+  const uint64_t lsn = snapshot_and_tail(tail);
+  tail[0].mutable_header()->set_snapshot_lsn(lsn - 1);
+  auto other = Import(b, "hall", tail);
+  EXPECT_EQ(other.status().code(), absl::StatusCode::kFailedPrecondition) << other.status();
+  EXPECT_TRUE(MapNames(1).empty());
+  ExpectNothingStaged(1);
+
+  // The intact tail of a fresh snapshot makes the copy serve, equal to the source.
+  snapshot_and_tail(tail);
+  auto applied = Import(b, "hall", tail);
+  ASSERT_TRUE(applied.ok()) << applied.status();
+  EXPECT_EQ(applied->tail_batches(), 3u);
+  EXPECT_EQ(b.GetMapStats("hall")->observations(), a.GetMapStats("hall")->observations());
+  EXPECT_EQ(b.GetMap("hall")->move_state(), v1::MAP_MOVE_STATE_SERVING);
 }
 
 TEST_F(MapTransferTest, FremenctlExportAndImportRoundTripAFile) {

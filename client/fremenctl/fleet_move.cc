@@ -1,6 +1,10 @@
 #include "client/fremenctl/fleet_move.h"
 
 #include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <thread>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -11,8 +15,10 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/time/clock.h"
+#include "base/mutex.h"
 #include "client/fremenctl/connection.h"
 #include "client/fremenctl/exit_codes.h"
 #include "client/fremenctl/fleet_maps.h"
@@ -35,6 +41,11 @@ struct MoveArgs {
   // send GOAWAY and finish their streams), and a call on one still reaches the old copy.
   double drain_seconds = 5;
   bool dry_run = false;
+  // Maps copied at once (rebalance).
+  int parallel = 4;
+  // Test only: once every snapshot is copied (writes still going on), create this file and wait
+  // until it is removed, so that a test acts at that point without guessing when it is.
+  std::string pause_after_snapshot;
 };
 
 // One map to move, and what an earlier run left of it.
@@ -42,7 +53,25 @@ struct Move {
   std::string map, from, to;
   bool committed = false;  // the source's copy is MOVED already
   bool stale_target = false;  // the target holds a copy from a run that did not commit
+  bool source_stopped = false;  // the source's writes were left stopped by a run that did not commit
+  uint64_t snapshot_lsn = 0;    // the copy's snapshot (phase 1), which its tail follows
+  bool copied = false;          // the snapshot is on the target (so undone if the run gives up)
 };
+
+// Runs job(i) for i in [0, n), `parallel` at a time; their statuses, by i.
+std::vector<absl::Status> RunParallel(size_t n, int parallel, const std::function<absl::Status(size_t)>& job) {
+  std::vector<absl::Status> statuses(n);
+  std::atomic<size_t> next{0};
+  std::vector<std::thread> threads;
+  const size_t count = std::min<size_t>(n, static_cast<size_t>(std::max(parallel, 1)));
+  for (size_t t = 0; t < count; ++t) {
+    threads.emplace_back([&] {
+      for (size_t i; (i = next++) < n;) statuses[i] = job(i);
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  return statuses;
+}
 
 // The daemons' clients, by address.
 class Fleet {
@@ -120,47 +149,104 @@ class Mover {
     throw CLI::RuntimeError(kExitFailure);
   }
 
+  // Phase 1, snapshots (writes go on), then phase 1b, tails (writes stopped): every map's
+  // snapshot is copied before any map's writes stop, so that a map's writers wait only for the
+  // tails and the proxy's reload, not for the other maps' snapshots.
   void Copy(std::vector<Move>& moves) {
-    std::vector<const Move*> done;
+    std::vector<Move*> todo;
     for (Move& m : moves) {
-      if (m.committed) continue;
-      const Client& from = fleet_.Of(m.from);
-      const Client& to = fleet_.Of(m.to);
-      absl::Status status;
-      if (auto stopped = from.SetMapMove(m.map, v1::MAP_MOVE_STEP_STOP_WRITES, "", GlobalCall()); !stopped.ok()) {
-        status = stopped.status();
-      } else if (stopped->state() == v1::MAP_MOVE_STATE_MOVED) {
-        m.committed = true;  // committed by a run that this one's listing raced with
-        continue;
-      }
-      if (status.ok() && m.stale_target) {
-        // Left by a run that did not commit: the source has been the map's owner since.
-        status = to.DeleteMap(m.map, GlobalCall());
-        if (absl::IsNotFound(status)) status = absl::OkStatus();
-      }
-      const absl::Time start = absl::Now();
-      if (status.ok()) {
-        auto copied = from.CopyMapTo(to, m.map, "", TransferCall());
-        status = copied.status();
-        if (copied.ok()) {
-          std::printf("copied %s to %s (%llu bytes in %.2f s)\n", m.map.c_str(), m.to.c_str(),
-                      static_cast<unsigned long long>(copied->bytes()), absl::ToDoubleSeconds(absl::Now() - start));
-          std::fflush(stdout);
-        }
-      }
-      if (!status.ok()) {
-        ReportCall(command_, m.from, absl::StrCat("copying map ", m.map, " to ", m.to), status, m.map);
-        GiveUp(done, m);
-      }
-      done.push_back(&m);
+      if (!m.committed) todo.push_back(&m);
     }
+    if (todo.empty()) return;
+    ReportFailures(todo, RunParallel(todo.size(), args_.parallel, [&](size_t i) { return Snapshot(*todo[i]); }),
+                   "copying the snapshot of map ");
+    std::erase_if(todo, [](const Move* m) { return m->committed; });
+    if (!args_.pause_after_snapshot.empty()) PauseForTest();
+    ReportFailures(todo, RunParallel(todo.size(), args_.parallel, [&](size_t i) { return CopyTail(*todo[i]); }),
+                   "copying the tail of map ");
   }
 
-  // Undoes the copies not yet committed, so that the sources own their maps again.
-  void GiveUp(const std::vector<const Move*>& done, const Move& failed) {
-    for (const Move* m : done) (void)fleet_.Of(m->to).DeleteMap(m->map, GlobalCall());
-    for (const Move* m : done) (void)fleet_.Of(m->from).SetMapMove(m->map, v1::MAP_MOVE_STEP_RESUME_WRITES, "", GlobalCall());
-    (void)fleet_.Of(failed.from).SetMapMove(failed.map, v1::MAP_MOVE_STEP_RESUME_WRITES, "", GlobalCall());
+  absl::Status Snapshot(Move& m) {
+    const Client& from = fleet_.Of(m.from);
+    const Client& to = fleet_.Of(m.to);
+    if (m.stale_target) {
+      // Left by a run that did not commit: the source has been the map's owner since.
+      absl::Status deleted = to.DeleteMap(m.map, GlobalCall());
+      if (!deleted.ok() && !absl::IsNotFound(deleted)) return deleted;
+    }
+    if (m.source_stopped) {
+      // An online snapshot starts only where writes go on.
+      auto resumed = from.SetMapMove(m.map, v1::MAP_MOVE_STEP_RESUME_WRITES, "", GlobalCall());
+      if (!resumed.ok()) return resumed.status();
+    }
+    const absl::Time start = absl::Now();
+    auto copied = from.CopyMapTo(to, m.map, "", TransferCall(), v1::MAP_EXPORT_KIND_ONLINE_SNAPSHOT);
+    if (!copied.ok()) {
+      if (absl::IsFailedPrecondition(copied.status())) {
+        // Committed by a run that this one's listing raced with?
+        auto there = CopyOn(from, m.map);
+        if (there.ok() && *there && (*there)->move_state() == v1::MAP_MOVE_STATE_MOVED) {
+          m.committed = true;
+          return absl::OkStatus();
+        }
+      }
+      return copied.status();
+    }
+    m.copied = true;
+    m.snapshot_lsn = copied->snapshot_lsn();
+    Say(absl::StrFormat("copied the snapshot of %s to %s (%llu bytes in %.2f s; writes go on)", m.map, m.to,
+                        static_cast<unsigned long long>(copied->bytes()), absl::ToDoubleSeconds(absl::Now() - start)));
+    return absl::OkStatus();
+  }
+
+  absl::Status CopyTail(Move& m) {
+    const Client& from = fleet_.Of(m.from);
+    const absl::Time start = absl::Now();
+    // Every batch submitted before this is applied when it returns: the tail is complete.
+    auto stopped = from.SetMapMove(m.map, v1::MAP_MOVE_STEP_STOP_WRITES, "", GlobalCall());
+    if (!stopped.ok()) return stopped.status();
+    auto tail = from.CopyMapTo(fleet_.Of(m.to), m.map, "", TransferCall(), v1::MAP_EXPORT_KIND_TAIL, m.snapshot_lsn);
+    if (!tail.ok()) return tail.status();
+    Say(absl::StrFormat("copied the tail of %s to %s (%llu batches in %.2f s with writes stopped)", m.map, m.to,
+                        static_cast<unsigned long long>(tail->tail_batches()),
+                        absl::ToDoubleSeconds(absl::Now() - start)));
+    return absl::OkStatus();
+  }
+
+  void Say(const std::string& line) {
+    base::MutexLock lock(&print_mutex_);
+    std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  }
+
+  void PauseForTest() const {
+    if (FILE* f = std::fopen(args_.pause_after_snapshot.c_str(), "w"); f != nullptr) {
+      std::fputs("snapshots copied\n", f);
+      std::fclose(f);
+    }
+    while (std::filesystem::exists(args_.pause_after_snapshot)) absl::SleepFor(absl::Milliseconds(20));
+  }
+
+  // Gives the run up when a copy failed, naming each failure.
+  void ReportFailures(const std::vector<Move*>& todo, const std::vector<absl::Status>& statuses, const char* what) {
+    bool failed = false;
+    for (size_t i = 0; i < todo.size(); ++i) {
+      if (statuses[i].ok()) continue;
+      ReportCall(command_, todo[i]->from, absl::StrCat(what, todo[i]->map, " to ", todo[i]->to), statuses[i],
+                 todo[i]->map);
+      failed = true;
+    }
+    if (failed) GiveUp(todo);
+  }
+
+  // Undoes the copies not yet committed, so that the sources own their maps again (and take writes).
+  void GiveUp(const std::vector<Move*>& todo) {
+    for (const Move* m : todo) {
+      if (m->copied) (void)fleet_.Of(m->to).DeleteMap(m->map, GlobalCall());
+    }
+    for (const Move* m : todo) {
+      (void)fleet_.Of(m->from).SetMapMove(m->map, v1::MAP_MOVE_STEP_RESUME_WRITES, "", GlobalCall());
+    }
     Fail("nothing was moved (the copies made are deleted, the maps take writes where they were); run this again "
          "once the cause is fixed");
   }
@@ -209,6 +295,7 @@ class Mover {
   const std::string command_;
   const MoveArgs& args_;
   const Fleet& fleet_;
+  base::Mutex print_mutex_;  // the copies' lines, from several threads
 };
 
 // What to do with `map`, held by `source` (not its owner `owner`), given the owner's copy if any.
@@ -224,6 +311,7 @@ std::optional<Move> PlanOne(const std::string& command, const std::string& map, 
     return std::nullopt;
   }
   m.stale_target = !m.committed && owner_copy.has_value();
+  m.source_stopped = source_copy.move_state() == v1::MAP_MOVE_STATE_WRITES_STOPPED;
   return m;
 }
 
@@ -260,8 +348,10 @@ void RunRebalance(const MoveArgs& a) {
       if (address != owner) others.push_back(address);
     }
     if (others.empty()) {
-      // On its owner. Writes left stopped by a run that died before it committed are resumed.
-      if (owner_copy->move_state() == v1::MAP_MOVE_STATE_WRITES_STOPPED) {
+      // On its owner. Writes left stopped (or a tail left recording) by a run that died before it
+      // committed are resumed.
+      if (owner_copy->move_state() == v1::MAP_MOVE_STATE_WRITES_STOPPED ||
+          owner_copy->move_state() == v1::MAP_MOVE_STATE_COPYING) {
         (void)fleet.Of(owner).SetMapMove(name, v1::MAP_MOVE_STEP_RESUME_WRITES, "", GlobalCall());
       }
       continue;
@@ -319,6 +409,10 @@ void AddProxyOptions(CLI::App& app, MoveArgs& a) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_flag("--dry-run", a.dry_run, "only list the moves");
+  // Hidden (no group): for tests (tests/fleet_online_move_test.cc).
+  app.add_option("--test-pause-after-snapshot", a.pause_after_snapshot,
+                 "test only: once the snapshots are copied, create FILE and wait until it is removed")
+      ->group("");
 }
 
 }  // namespace
@@ -332,9 +426,13 @@ void RegisterFleetMoveCommands(CLI::App& fleet) {
                         "one is asked for its maps (add daemons being removed with --address)")
       ->required();
   AddProxyOptions(*rebalance, *r);
+  rebalance->add_option("--parallel", r->parallel, "maps copied at once (each daemon serves its exports and imports)")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   rebalance->footer(
-      "Writers of a moving map get UNAVAILABLE (\"map M is moving to another daemon; retry\") from when its copy "
-      "starts\nuntil the proxy routes to its new owner; queries go on. Run again after any failure "
+      "A moving map's snapshot is copied while its writers go on; then its writes stop and only the batches\n"
+      "written meanwhile are copied. Its writers get UNAVAILABLE (\"map M is moving to another daemon; retry\")\n"
+      "from then until the proxy routes to its new owner; queries go on. Run again after any failure "
       "(docs/fleet.md).");
   rebalance->callback([r] { RunRebalance(*r); });
 

@@ -188,8 +188,10 @@ class Client {
   // --- a map's copy as a stream, and moves (docs/fleet.md, "Moving a map") ---
   // The map's export (header, data chunks, trailer): `receive` is called with each message in
   // order; a non-OK answer cancels the stream and is returned. Tried once. chunk_bytes 0: 1 MiB.
+  // `kind` and `tail_after_lsn`: ExportMapRequest's (an online move's snapshot, then its tail).
   absl::Status ExportMap(absl::string_view map, const std::function<absl::Status(const v1::MapChunk&)>& receive,
-                         const CallOptions& call = {}, uint32_t chunk_bytes = 0) const;
+                         const CallOptions& call = {}, uint32_t chunk_bytes = 0,
+                         v1::MapExportKind kind = v1::MAP_EXPORT_KIND_SNAPSHOT, uint64_t tail_after_lsn = 0) const;
   // An export as a new map: `next` fills the next message and answers true, or false once the
   // trailer has been given; an error cancels the stream and is returned. `map` is the header's
   // map (sent as x-fremen-map, so that a proxy routes the call to its owner). Tried once.
@@ -197,9 +199,12 @@ class Client {
                                                   const std::function<absl::StatusOr<bool>(v1::MapChunk&)>& next,
                                                   const CallOptions& call = {}) const;
   // ExportMap of `map` here streamed straight into ImportMap on `target`, as `new_name` (empty:
-  // the same name).
+  // the same name). An online move copies kind ONLINE_SNAPSHOT, then (writes stopped) kind TAIL
+  // after the snapshot's LSN (the first answer's snapshot_lsn) into the same name.
   absl::StatusOr<v1::ImportMapResponse> CopyMapTo(const Client& target, absl::string_view map,
-                                                  absl::string_view new_name = "", const CallOptions& call = {}) const;
+                                                  absl::string_view new_name = "", const CallOptions& call = {},
+                                                  v1::MapExportKind kind = v1::MAP_EXPORT_KIND_SNAPSHOT,
+                                                  uint64_t tail_after_lsn = 0) const;
   // A step of a move on the daemon that holds the map (AdminService.SetMapMove). Each step is
   // idempotent, so it is retried.
   absl::StatusOr<v1::SetMapMoveResponse> SetMapMove(absl::string_view map, v1::MapMoveStep step,

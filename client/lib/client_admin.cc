@@ -142,10 +142,13 @@ absl::StatusOr<v1::SalvageMapResponse> Client::SalvageMap(absl::string_view map,
 
 absl::Status Client::ExportMap(absl::string_view map,
                               const std::function<absl::Status(const v1::MapChunk&)>& receive,
-                              const CallOptions& call, uint32_t chunk_bytes) const {
+                              const CallOptions& call, uint32_t chunk_bytes, v1::MapExportKind kind,
+                              uint64_t tail_after_lsn) const {
   v1::ExportMapRequest request;
   request.set_map(std::string(map));
   request.set_chunk_bytes(chunk_bytes);
+  request.set_kind(kind);
+  request.set_tail_after_lsn(tail_after_lsn);
   absl::Status refused;
   absl::Status status = connection_->CallOnce(call, map, [&](grpc::ClientContext& context) {
     auto reader = connection_->admin().ExportMap(&context, request);
@@ -192,10 +195,13 @@ absl::StatusOr<v1::ImportMapResponse> Client::ImportMap(
 }
 
 absl::StatusOr<v1::ImportMapResponse> Client::CopyMapTo(const Client& target, absl::string_view map,
-                                                        absl::string_view new_name, const CallOptions& call) const {
+                                                        absl::string_view new_name, const CallOptions& call,
+                                                        v1::MapExportKind kind, uint64_t tail_after_lsn) const {
   const std::string name(new_name.empty() ? map : new_name);
   v1::ExportMapRequest request;
   request.set_map(std::string(map));
+  request.set_kind(kind);
+  request.set_tail_after_lsn(tail_after_lsn);
   auto context = connection_->NewContext(connection_->DeadlineOf(call), map);
   auto reader = connection_->admin().ExportMap(context.get(), request);
   bool ended = false;

@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "client/lib/backoff.h"
@@ -273,7 +274,11 @@ void IngestSession::Run() {
     }
     // UNAVAILABLE: the daemon is restarting or out of reach. OK with batches unanswered: it ended
     // the stream early. Either way, resend them on a new stream.
-    if (!status.ok() && !IsRetryable(status.code())) return FailLocked(status);
+    // A stream reset by a proxy whose upstream died (nginx on a kill -9 of the daemon: RST_STREAM
+    // INTERNAL_ERROR, which gRPC reports as INTERNAL) is a daemon out of reach too: the batches are
+    // idempotent by (writer, sequence), so resending them cannot apply one twice.
+    const bool reset = status.code() == absl::StatusCode::kInternal && absl::StrContains(status.message(), "RST_STREAM");
+    if (!status.ok() && !IsRetryable(status.code()) && !reset) return FailLocked(status);
     const absl::Time now = absl::Now();
     if (!failing_since) failing_since = now;
     if (now - *failing_since >= options_.reconnect_timeout || !backoff.MayRetry()) {

@@ -173,6 +173,10 @@ v1::MapMoveState MoveStateToProto(storage::MoveState state) {
       return v1::MAP_MOVE_STATE_WRITES_STOPPED;
     case storage::MoveState::kMoved:
       return v1::MAP_MOVE_STATE_MOVED;
+    case storage::MoveState::kCopying:
+      return v1::MAP_MOVE_STATE_COPYING;
+    case storage::MoveState::kIncoming:
+      return v1::MAP_MOVE_STATE_INCOMING;
   }
   return v1::MAP_MOVE_STATE_UNSPECIFIED;
 }

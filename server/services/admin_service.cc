@@ -9,6 +9,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "server/services/backup_path.h"
+#include "server/services/map_tail.h"
 #include "server/rpc/logging.h"
 #include "server/convert/map_convert.h"
 #include "server/jobs/map_list.h"
@@ -365,14 +366,18 @@ grpc::ServerWriteReactor<v1::MapChunk>* AdminServiceImpl::ExportMap(grpc::Callba
         if (!store.ok()) return store.status();
         const absl::Time start = admin_.clock->Now();
         uint64_t bytes = 0;
-        const absl::Status status = server::ExportMap(
-            **store, *name, admin_.config->data_dir, request->chunk_bytes(), [&](const v1::MapChunk& chunk) {
-              bytes += chunk.data().data().size();
-              return out.Write(chunk);
-            });
+        const auto send = [&](const v1::MapChunk& chunk) {
+          bytes += chunk.data().data().size() + chunk.batch().batch().size();
+          return out.Write(chunk);
+        };
+        const bool tail = request->kind() == v1::MAP_EXPORT_KIND_TAIL;
+        const absl::Status status =
+            tail ? ExportMapTail(**store, *name, request->tail_after_lsn(), send)
+                 : server::ExportMap(**store, *name, admin_.config->data_dir, request->chunk_bytes(), request->kind(),
+                                     send);
         if (status.ok()) {
-          DaemonLog()->info("export of map {}: {} bytes in {}", *name, bytes,
-                            absl::FormatDuration(admin_.clock->Now() - start));
+          DaemonLog()->info("export of map {} ({}): {} bytes in {}", *name, v1::MapExportKind_Name(request->kind()),
+                            bytes, absl::FormatDuration(admin_.clock->Now() - start));
         }
         return status;
       });
@@ -395,10 +400,24 @@ absl::Status AdminServiceImpl::Import(StreamReader<v1::MapChunk>& in, const grpc
   auto staging = NewTransferDir(admin_.config->data_dir, "import");
   if (!staging.ok()) return staging.status();
   MapImportWriter writer(*staging);
+  MapTailReader tail;
+  std::string name;
   const auto import = [&]() -> absl::StatusOr<storage::MapInfo> {
     v1::MapChunk chunk;
-    std::string name;
-    while (in.Read(chunk)) {
+    if (!in.Read(chunk)) return writer.Finish();  // an empty stream
+    if (chunk.has_header() && chunk.header().kind() == v1::MAP_EXPORT_KIND_TAIL) {
+      // An online move's tail, for the incoming copy here (server/services/map_tail.h).
+      auto resolved = ResolveMapName(context, chunk.header().map(), "header.map");
+      if (!resolved.ok()) return resolved.status();
+      name = *std::move(resolved);
+      do {
+        if (absl::Status added = tail.Add(chunk); !added.ok()) return added;
+      } while (in.Read(chunk));
+      if (context.IsCancelled()) return absl::CancelledError("ImportMap: the client cancelled the stream");
+      if (absl::Status finished = tail.Finish(); !finished.ok()) return finished;
+      return ApplyMapTail(**store, name, tail);
+    }
+    do {
       if (absl::Status added = writer.Add(chunk); !added.ok()) return added;
       if (chunk.has_header()) {
         // Refused before the data is sent: the name is known from the first message.
@@ -410,7 +429,7 @@ absl::Status AdminServiceImpl::Import(StreamReader<v1::MapChunk>& in, const grpc
           return absl::AlreadyExistsError(absl::StrCat("map \"", name, "\" already exists"));
         }
       }
-    }
+    } while (in.Read(chunk));
     if (context.IsCancelled()) return absl::CancelledError("ImportMap: the client cancelled the stream");
     if (absl::Status finished = writer.Finish(); !finished.ok()) return finished;
     return (*store)->RestoreMap(writer.dir(), name, CallDeadline(context));
@@ -419,11 +438,20 @@ absl::Status AdminServiceImpl::Import(StreamReader<v1::MapChunk>& in, const grpc
   std::error_code error;
   fs::remove_all(*staging, error);
   if (!info.ok()) {
+    if (tail.header()) DropIncomingCopy(**store, name);
     DaemonLog()->warn("import refused: {}", info.status().ToString());
     return RenameNameField(info.status(), "header.map");
   }
   MapInfoToProto(*info, *response.mutable_map());
   AddMoveState(**store, *response.mutable_map());
+  if (tail.header()) {
+    response.set_bytes(tail.bytes());
+    response.set_tail_batches(tail.records().size());
+    response.set_duration_seconds(absl::ToDoubleSeconds(admin_.clock->Now() - start));
+    DaemonLog()->info("map {}: its tail of {} batches applied; it serves", info->name, tail.records().size());
+    return absl::OkStatus();
+  }
+  if (writer.header()) response.set_snapshot_lsn(writer.header()->snapshot_lsn());
   response.set_bytes(writer.bytes());
   const absl::Duration took = admin_.clock->Now() - start;
   response.set_duration_seconds(absl::ToDoubleSeconds(took));

@@ -24,7 +24,7 @@ grpc::ServerUnaryReactor* IngestServiceImpl::LastSequence(grpc::CallbackServerCo
     if (!map.ok()) return map.status();
     // A writer asking where to continue is about to write: during a move, its answer is the new
     // owner's.
-    if ((*map)->Move().state != storage::MoveState::kServing) return storage::MovingError((*map)->info().name);
+    if (!storage::TakesWrites((*map)->Move().state)) return storage::MovingError((*map)->info().name);
     response->set_last_sequence((*map)->LastSequence(request->writer_id()));
     return absl::OkStatus();
   });

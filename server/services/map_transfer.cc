@@ -95,7 +95,12 @@ absl::StatusOr<std::string> NewTransferDir(const std::string& data_dir, const st
 }
 
 absl::Status ExportMap(storage::Store& store, const std::string& name, const std::string& data_dir,
-                       uint32_t chunk_bytes, const std::function<bool(const v1::MapChunk&)>& send) {
+                       uint32_t chunk_bytes, v1::MapExportKind kind,
+                       const std::function<bool(const v1::MapChunk&)>& send) {
+  if (kind != v1::MAP_EXPORT_KIND_SNAPSHOT && kind != v1::MAP_EXPORT_KIND_ONLINE_SNAPSHOT) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("kind: must be SNAPSHOT or ONLINE_SNAPSHOT here, got ", v1::MapExportKind_Name(kind)));
+  }
   if (chunk_bytes > kMaxChunkBytes) {
     return absl::InvalidArgumentError(absl::StrCat("chunk_bytes must be at most ", kMaxChunkBytes, ", got ", chunk_bytes));
   }
@@ -107,12 +112,21 @@ absl::Status ExportMap(storage::Store& store, const std::string& name, const std
   const RemoveOnExit cleanup(*staging);
   // BackupMap makes the directory itself.
   const std::string dir = *staging + "/map";
-  if (auto copied = store.BackupMap(name, dir); !copied.ok()) return copied.status();
+  if (kind == v1::MAP_EXPORT_KIND_ONLINE_SNAPSHOT) {
+    // Before the snapshot's checkpoint: every batch logged after it is then recorded.
+    auto map = store.Map(name);
+    if (!map.ok()) return map.status();
+    if (absl::Status started = (*map)->StartTail(); !started.ok()) return started;
+  }
+  uint64_t snapshot_lsn = 0;
+  if (auto copied = store.BackupMap(name, dir, &snapshot_lsn); !copied.ok()) return copied.status();
 
   v1::MapChunk message;
   v1::MapExportHeader& header = *message.mutable_header();
   header.set_format(kMapExportFormat);
   header.set_map(name);
+  header.set_kind(kind);
+  header.set_snapshot_lsn(snapshot_lsn);
   MapInfoToProto(*info, *header.mutable_info());
   auto encoded = ReadWhole(absl::StrCat(dir, "/", kMapInfoFile));
   if (!encoded.ok()) return encoded.status();
@@ -189,6 +203,8 @@ absl::Status MapImportWriter::Add(const v1::MapChunk& chunk) {
       return AddData(chunk.data());
     case v1::MapChunk::kTrailer:
       return AddTrailer(chunk.trailer());
+    case v1::MapChunk::kBatch:
+      return Damaged("a tail's batch in a map's snapshot");
     case v1::MapChunk::PART_NOT_SET:
       break;
   }
@@ -199,6 +215,9 @@ absl::Status MapImportWriter::AddHeader(const v1::MapExportHeader& header) {
   if (header.format() != kMapExportFormat) {
     return absl::FailedPreconditionError(absl::StrCat("the stream's format is ", header.format(), "; this fremend reads ",
                                                       kMapExportFormat, " (import it with a newer fremend)"));
+  }
+  if (header.kind() == v1::MAP_EXPORT_KIND_TAIL) {
+    return absl::InvalidArgumentError("header.kind: a tail is not a map's snapshot");
   }
   auto info = storage::DecodeMapInfo(header.map_info());
   if (!info.ok()) return Damaged(absl::StrCat("header.map_info: ", info.status().message()));
@@ -216,6 +235,10 @@ absl::Status MapImportWriter::AddHeader(const v1::MapExportHeader& header) {
   if (absl::Status s = WriteWhole(absl::StrCat(dir_, "/", kMapInfoFile), header.map_info()); !s.ok()) return s;
   if (!header.last_update().empty()) {
     if (absl::Status s = WriteWhole(absl::StrCat(dir_, "/", kLastUpdateFile), header.last_update()); !s.ok()) return s;
+  }
+  if (header.kind() == v1::MAP_EXPORT_KIND_ONLINE_SNAPSHOT) {
+    const std::string marker = absl::StrCat(dir_, "/", storage::kIncomingFile);
+    if (absl::Status s = WriteWhole(marker, absl::StrCat(header.snapshot_lsn())); !s.ok()) return s;
   }
   header_ = header;
   return absl::OkStatus();

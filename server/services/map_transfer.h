@@ -48,8 +48,12 @@ absl::StatusOr<std::string> NewTransferDir(const std::string& data_dir, const st
 // header, every data chunk and the trailer, in order; stops at the first `send` that answers
 // false (the client has gone: Cancelled). The staging copy is removed before returning.
 // chunk_bytes 0 = kDefaultChunkBytes; larger than kMaxChunkBytes is InvalidArgument.
+// kind ONLINE_SNAPSHOT first starts the map's tail (MapStore::StartTail), so that the batches
+// logged after the snapshot can follow it (ExportMapTail, server/services/map_tail.h); the header
+// gives the snapshot's LSN either way. TAIL is not this function's (InvalidArgument).
 absl::Status ExportMap(storage::Store& store, const std::string& name, const std::string& data_dir,
-                       uint32_t chunk_bytes, const std::function<bool(const v1::MapChunk&)>& send);
+                       uint32_t chunk_bytes, v1::MapExportKind kind,
+                       const std::function<bool(const v1::MapChunk&)>& send);
 
 // Receives one exported map into `dir` (an empty directory the caller made and removes), checking
 // each message as it comes. Add the messages in order, then Finish.
@@ -60,7 +64,8 @@ class MapImportWriter {
 
   // The first message must be the header, the last the trailer. DataLoss on a damaged, misplaced
   // or missing chunk; FailedPrecondition for a later format; InvalidArgument for a header whose
-  // files are not a map's (paths other than its shards').
+  // files are not a map's (paths other than its shards') or that is a tail's. An ONLINE_SNAPSHOT's
+  // files include storage::kIncomingFile, so that the restored map waits for its tail.
   absl::Status Add(const v1::MapChunk& chunk);
   // Once the client's stream has ended: DataLoss unless the trailer came and matched (a torn stream).
   absl::Status Finish() const;

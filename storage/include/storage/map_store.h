@@ -75,6 +75,10 @@ struct StoreOptions {
   // LMDB aborts the process on some damaged pages, and a damaged map must fail alone, naming its
   // file, not take the daemon down. Costs one read of the files at open. Default: true.
   bool probe_before_open = true;
+  // An online move's tail (StartTail): the bytes of batches a map records while its snapshot is
+  // copied, at most. Past it the tail is given up (Tail answers FailedPrecondition) and the move is
+  // made again. Default: 256 MiB.
+  uint64_t max_tail_bytes = 256ull << 20;
   // Test only: a publication waits before its first slice until a batch has been applied and
   // acknowledged, so that a test sees batches acknowledged while a publication runs however long
   // a slice takes against a log sync. Default: false.
@@ -114,12 +118,29 @@ struct MapStats {
 // Where a map is in a move to another daemon (docs/fleet.md, "Moving a map").
 enum class MoveState {
   kServing,        // takes writes
-  kWritesStopped,  // a move is copying it: writes refused, until ResumeWrites or MarkMoved
+  kWritesStopped,  // a move copies its tail (or, offline, the map): writes refused, until ResumeWrites or MarkMoved
   kMoved,          // the move is committed: writes refused for good (kept across a reopen)
+  kCopying,        // an online move copies its snapshot: takes writes, recording them (StartTail)
+  kIncoming,       // a move's copy waiting for its tail (ApplyTail): refuses writes (kept across a reopen)
 };
 struct MoveStatus {
   MoveState state = MoveState::kServing;
-  std::string moved_to;  // kMoved: where it went
+  std::string moved_to;   // kMoved: where it went
+  uint64_t snapshot_lsn = 0;  // kIncoming: the snapshot's log position, which its tail continues
+};
+
+// The file in a map's directory (and in a backup's: RestoreMap copies it) that marks a move's copy
+// waiting for its tail (kIncoming), holding the snapshot's LSN in decimal.
+inline constexpr char kIncomingFile[] = "incoming";
+
+// Whether a map in `state` takes writes (Ingest, LastSequence).
+inline bool TakesWrites(MoveState state) { return state == MoveState::kServing || state == MoveState::kCopying; }
+
+// A batch of a move's tail: its place in the source's log and its EncodeBatch bytes.
+struct TailRecord {
+  uint64_t lsn = 0;
+  std::string batch;
+  bool operator==(const TailRecord&) const = default;
 };
 
 // The status writes get while a map moves (Unavailable: clients resend, and the proxy takes their
@@ -186,6 +207,23 @@ class MapStore {
   virtual absl::Status MarkMoved(const std::string& to) = 0;
   virtual MoveStatus Move() const = 0;
 
+  // --- online moves: the snapshot while writes go on, then the tail (docs/fleet.md) ---
+  // From now on every batch logged is also recorded in memory (at most max_tail_bytes), and
+  // PublishModels is refused (MovingError): writes go on. Then Backup's `lsn` says where the
+  // snapshot is, and, once StopWrites has returned, Tail gives the batches logged after it.
+  // FailedPrecondition unless serving or copying (a capture in progress starts again, empty).
+  // Ended by ResumeWrites (back to serving), MarkMoved or a reopen.
+  virtual absl::Status StartTail() = 0;
+  // The batches logged after `after`, in log order. FailedPrecondition unless StartTail was called
+  // and writes are stopped since, or when the capture was given up (it outgrew max_tail_bytes, an
+  // update job published meanwhile, or a storage error latched).
+  virtual absl::StatusOr<std::vector<TailRecord>> Tail(uint64_t after) const = 0;
+  // For a copy restored kIncoming: applies `tail` (the source's Tail after its snapshot) through
+  // the write path — logged, deduplicated, acknowledged — then checkpoints and serves.
+  // FailedPrecondition unless kIncoming with snapshot_lsn == `after`; DataLoss when a batch does
+  // not decode or is not new (the tail does not continue this snapshot): the copy is not to be used.
+  virtual absl::Status ApplyTail(uint64_t after, std::span<const TailRecord> tail) = 0;
+
   // --- reads ---
   // p at every (time, key): out[i·keys + j] for times[i], keys[j].
   virtual std::vector<float> Predict(std::span<const uint64_t> keys, std::span<const double> times,
@@ -211,9 +249,10 @@ class MapStore {
                                                                        const PredictOptions& options) const = 0;
   virtual MapStats Stats() const = 0;
   // A consistent copy of every shard, the map's info and its last update record into `dir`
-  // (created, must be empty).
+  // (created, must be empty). `lsn`, when given, is set to the log position the copy holds every
+  // batch up to (and none after).
   // Returns the bytes written.
-  virtual absl::StatusOr<uint64_t> Backup(const std::string& dir) = 0;
+  virtual absl::StatusOr<uint64_t> Backup(const std::string& dir, uint64_t* lsn = nullptr) = 0;
   // Verifies the map's files while it serves (storage/verify.h). Each shard is read in a forked
   // child process through LMDB's reader table: LMDB allows one environment per file per process,
   // and an abort on a damaged page ends the child, not the daemon. Checkpoints wait meanwhile (as

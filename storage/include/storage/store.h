@@ -59,9 +59,12 @@ class Store {
 
   // A consistent copy of a map to `dir`, while it keeps serving.
   // Returns the bytes written.
-  absl::StatusOr<uint64_t> BackupMap(const std::string& name, const std::string& dir) ABSL_LOCKS_EXCLUDED(mutex_);
+  // `lsn`: as MapStore::Backup's.
+  absl::StatusOr<uint64_t> BackupMap(const std::string& name, const std::string& dir, uint64_t* lsn = nullptr)
+      ABSL_LOCKS_EXCLUDED(mutex_);
   // A backup made by BackupMap as a new map named `name` (empty: the backed-up map's name). The copy is probed and
-  // loaded (every record checked) before the map is listed.
+  // loaded (every record checked) before the map is listed. A backup dir holding kIncomingFile (an online move's
+  // snapshot, server/services/map_transfer.h) gives a map that refuses writes until its tail is applied.
   // A shard whose check has not finished by `deadline` makes it DeadlineExceeded, nothing created.
   absl::StatusOr<MapInfo> RestoreMap(const std::string& dir, const std::string& name,
                                      absl::Time deadline = absl::InfiniteFuture()) ABSL_LOCKS_EXCLUDED(mutex_);
