@@ -620,7 +620,9 @@ TEST_F(HttpApiTest, BadInputsAreTheirGrpcStatusWithItsMessage) {
     EXPECT_EQ(status.fields().at("code").number_value(), row.code);
     EXPECT_TRUE(status.fields().at("details").has_list_value());
     EXPECT_THAT(answer.body, HasSubstr(row.message));
-    if (row.http_status == 405) EXPECT_FALSE(answer.allow.empty());
+    if (row.http_status == 405) {
+      EXPECT_FALSE(answer.allow.empty());
+    }
   }
 }
 
