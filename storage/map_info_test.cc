@@ -32,11 +32,12 @@ TEST(MapInfoTest, EncodingRoundTrips) {
   EXPECT_EQ(decoded->order_rule, info.order_rule);
 }
 
-TEST(MapInfoTest, NewMapsTakeTheWeightedRule) {
+TEST(MapInfoTest, NewMapsTakeTheMarginRule) {
   const MapInfo info;
-  EXPECT_EQ(info.order_rule.selection, model::OrderSelection::kWeighted);
-  EXPECT_EQ(info.criterion, model::ErrorCriterion::kSquared);
-  EXPECT_EQ(info.error_half_life, 3 * 86400.0);
+  EXPECT_EQ(info.order_rule.selection, model::OrderSelection::kMargin);
+  EXPECT_EQ(info.order_rule.margin, 0.001);
+  EXPECT_EQ(info.criterion, model::ErrorCriterion::kThreshold);
+  EXPECT_EQ(info.error_half_life, 7 * 86400.0);
 }
 
 // A version-1 record (before the order rule was stored) is the version-2 encoding without its last

@@ -123,7 +123,7 @@ TEST_F(FremenctlEvalTest, PeriodicModelBeatsTheMeanOnAPeriodicSignal) {
 TEST_F(FremenctlEvalTest, ReplayAddsTheOrderEachRuleSelects) {
   const RunResult result = EvalSquareWave({"--replay"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  static const std::regex kRuleLine(R"((paper|margin|default)\t(\d+)\t(\d+\.\d+)\t(\d+\.\d+))");
+  static const std::regex kRuleLine(R"((paper|margin|default|weighted)\t(\d+)\t(\d+\.\d+)\t(\d+\.\d+))");
   std::istringstream lines(result.out);
   std::vector<std::string> rules;
   int table_lines = 0;
@@ -139,7 +139,7 @@ TEST_F(FremenctlEvalTest, ReplayAddsTheOrderEachRuleSelects) {
     }
   }
   EXPECT_EQ(table_lines, 6);
-  EXPECT_EQ(rules, (std::vector<std::string>{"paper", "margin", "default"}));
+  EXPECT_EQ(rules, (std::vector<std::string>{"paper", "margin", "default", "weighted"}));
   // Without --replay, the table alone.
   const RunResult plain = EvalSquareWave();
   EXPECT_EQ(plain.out.find("paper"), std::string::npos);

@@ -108,7 +108,7 @@ TEST_F(FremenctlTest, MapsCreateListGetDelete) {
   ASSERT_EQ(get.exit_code, 0) << get.err;
   EXPECT_THAT(get.out, HasSubstr("max_order: 3"));
   EXPECT_THAT(get.out, HasSubstr("criterion: squared"));
-  EXPECT_THAT(get.out, HasSubstr("order_selection: weighted, temperature 0.01"));  // the default
+  EXPECT_THAT(get.out, HasSubstr("order_selection: margin 0.001"));  // the default
   RunResult margin = Run({"maps", "create", "gates", "--generic", "--order-selection", "margin", "--order-margin",
                           "0.003", "--criterion", "threshold"});
   ASSERT_EQ(margin.exit_code, 0) << margin.err;

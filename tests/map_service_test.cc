@@ -96,9 +96,9 @@ TEST_F(MapServiceTest, CreateMapFillsInTheDefaults) {
   EXPECT_TRUE(created.has_max_order());
   EXPECT_EQ(created.max_order(), 5u);
   EXPECT_TRUE(created.persistence());
-  EXPECT_EQ(created.error_half_life_seconds(), 3 * 86400);
-  EXPECT_EQ(created.criterion(), v1::ERROR_CRITERION_SQUARED);
-  EXPECT_EQ(created.order_selection(), v1::ORDER_SELECTION_WEIGHTED);
+  EXPECT_EQ(created.error_half_life_seconds(), 7 * 86400);
+  EXPECT_EQ(created.criterion(), v1::ERROR_CRITERION_THRESHOLD);
+  EXPECT_EQ(created.order_selection(), v1::ORDER_SELECTION_MARGIN);
   EXPECT_EQ(created.order_margin(), 0.001);
   EXPECT_EQ(created.order_temperature(), 0.01);
   EXPECT_EQ(created.lossless_sampling_seconds(), 0);

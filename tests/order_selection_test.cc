@@ -149,10 +149,10 @@ TEST_F(OrderSelectionTest, EachRuleIsHonouredAndTheDefaultIsNotWorseThanThePaper
   for (const Rule& rule : kRules) maps.push_back(Create(rule));
   ASSERT_FALSE(HasFailure());
   // The defaults filled in, and the values given kept.
-  EXPECT_EQ(maps[1].order_selection(), v1::ORDER_SELECTION_WEIGHTED);
-  EXPECT_EQ(maps[1].order_temperature(), 0.01);
-  EXPECT_EQ(maps[1].criterion(), v1::ERROR_CRITERION_SQUARED);
-  EXPECT_EQ(maps[1].error_half_life_seconds(), 3 * kDay);
+  EXPECT_EQ(maps[1].order_selection(), v1::ORDER_SELECTION_MARGIN);
+  EXPECT_EQ(maps[1].order_margin(), 0.001);
+  EXPECT_EQ(maps[1].criterion(), v1::ERROR_CRITERION_THRESHOLD);
+  EXPECT_EQ(maps[1].error_half_life_seconds(), 7 * kDay);
   EXPECT_EQ(maps[0].order_selection(), v1::ORDER_SELECTION_PAPER);
   EXPECT_EQ(maps[2].order_margin(), 0.004);
   EXPECT_EQ(maps[3].order_temperature(), 0.05);

@@ -432,6 +432,8 @@ bool RunIngest(const Options& o, const Client& client) {
   std::this_thread::sleep_for(std::chrono::duration<double>(o.warmup));
   for (auto& s : streams) s->TakeLatencies();
   std::vector<double> rates, batch_rates, latencies;
+  // A scan observes cells, a history states.
+  const char* unit = o.history_states > 0 ? "obs/s" : "cell-obs/s";
   for (int r = 0; r < o.repetitions && !failed(); ++r) {
     const auto [obs0, batches0] = total();
     const auto start = Clock::now();
@@ -440,7 +442,7 @@ bool RunIngest(const Options& o, const Client& client) {
     const double elapsed = Seconds(Clock::now() - start);
     rates.push_back(static_cast<double>(obs1 - obs0) / elapsed);
     batch_rates.push_back(static_cast<double>(batches1 - batches0) / elapsed);
-    std::printf("  window %d: %.2fM obs/s, %.0f batches/s\n", r + 1, rates.back() / 1e6, batch_rates.back());
+    std::printf("  window %d: %.2fM %s, %.0f batches/s\n", r + 1, rates.back() / 1e6, unit, batch_rates.back());
     std::fflush(stdout);
   }
   for (auto& s : streams) {
@@ -460,9 +462,9 @@ bool RunIngest(const Options& o, const Client& client) {
                                ? std::to_string(o.cells) + "-observation histories of " +
                                      std::to_string(o.history_states) + " state(s)"
                                : std::to_string(o.cells) + "-cell scans";
-  std::printf("ingest: %d streams × %s, ≤ %d unacknowledged each: median %.2fM obs/s "
+  std::printf("ingest: %d streams × %s, ≤ %d unacknowledged each: median %.2fM %s "
               "(%.0f batches/s) over %zu windows of %.0f s; ack latency p50 %.1f ms, p99 %.1f ms\n",
-              o.streams, what.c_str(), o.window, Median(rates) / 1e6, Median(batch_rates), rates.size(), o.seconds,
+              o.streams, what.c_str(), o.window, Median(rates) / 1e6, unit, Median(batch_rates), rates.size(), o.seconds,
               Quantile(latencies, 0.5) * 1e3, Quantile(latencies, 0.99) * 1e3);
   return ok;
 }

@@ -38,6 +38,7 @@ constexpr ReplayRule kReplayRules[] = {
     {"paper", model::ErrorCriterion::kThreshold, 7 * 86400.0, model::OrderRule{model::OrderSelection::kPaper}},
     {"margin", model::ErrorCriterion::kThreshold, 7 * 86400.0, model::OrderRule{model::OrderSelection::kMargin}},
     {"default", model::kDefaultCriterion, model::kDefaultErrorHalfLife, model::OrderRule{}},
+    {"weighted", model::ErrorCriterion::kSquared, 3 * 86400.0, model::OrderRule{model::OrderSelection::kWeighted}},
 };
 
 // Reports a failure on stderr and ends the program with `exit_code` (kExitFailure or kExitUsage).
@@ -100,15 +101,15 @@ void RegisterEvalCommand(CLI::App& app) {
                  "Blend the last training observation into the predictions (persistence model)");
   eval->add_flag("--replay", options->replay,
                  "Also feed --train day by day with nightly updates, as the daemon sees it, and print the test "
-                 "scores of the order each rule selects (paper, margin, default)");
+                 "scores of the order each rule selects (paper, margin, default, weighted)");
   eval->footer(
       "Trains one state on all of --train in one batch, then predicts every time of --test at each order\n"
       "0..L and prints one line per order: order<TAB>err<TAB>mse. err is the mean of |[p > 0.5] - s| (for 0/1\n"
       "states, the share of wrongly estimated samples), mse the mean of (p - s)^2.\n"
-      "With --replay, three more lines rule<TAB>order<TAB>err<TAB>mse: the order selected after a day-by-day\n"
+      "With --replay, four more lines rule<TAB>order<TAB>err<TAB>mse: the order selected after a day-by-day\n"
       "replay by the paper's rule (exact minimum of the thresholded errors, 7-day half-life), by the margin\n"
-      "rule of maps made before the weighted one (the same, a higher order wins by > 0.001) and by the\n"
-      "default of new maps (weighted rule on squared errors, 3-day half-life).\n"
+      "rule (the same, a higher order wins by > 0.001), by the default of new maps (the margin rule) and by\n"
+      "the weighted rule on squared errors with a 3-day half-life (a map setting).\n"
       "Exit codes: 0 success, 1 unreadable or invalid data file (the message names file:line), 2 bad usage.\n"
       "\n"
       "Example, the setting of the original FremenServer's published figures:\n"

@@ -147,13 +147,13 @@ void RegisterCreate(CLI::App& maps) {
       ->check(CLI::PositiveNumber);
   create->add_option("--periods", a->period_count, "number of harmonics of the longest period (default 24)")
       ->check(CLI::PositiveNumber);
-  create->add_option("--half-life", a->half_life, "half-life of the order errors, seconds (default 3 days)")
+  create->add_option("--half-life", a->half_life, "half-life of the order errors, seconds (default 7 days)")
       ->check(CLI::NonNegativeNumber);
-  create->add_option("--criterion", a->criterion, "order-selection error: squared (default) or threshold")
+  create->add_option("--criterion", a->criterion, "order-selection error: threshold (default) or squared")
       ->check(CLI::IsMember({"threshold", "squared"}));
   create->add_option("--order-selection", a->order_selection,
-                     "how the order is chosen from the decayed errors: weighted (default; the mean order of "
-                     "exp(-(r - r_min)/T) weights), margin (a higher order must win by --order-margin) or "
+                     "how the order is chosen from the decayed errors: margin (default; a higher order must "
+                     "win by --order-margin), weighted (the mean order of exp(-(r - r_min)/T) weights) or "
                      "paper (the exact minimum)")
       ->check(CLI::IsMember({"weighted", "margin", "paper"}));
   create->add_option("--order-margin", a->order_margin, "margin rule: how much a higher order must win by (0.001)")

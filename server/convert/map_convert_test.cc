@@ -38,9 +38,9 @@ TEST(MapConvertTest, UnsetFieldsTakeTheDefaults) {
   EXPECT_EQ(info->persistence, defaults.persistence);
   EXPECT_EQ(info->error_half_life, defaults.error_half_life);
   EXPECT_EQ(info->criterion, defaults.criterion);
-  EXPECT_EQ(info->criterion, model::ErrorCriterion::kSquared);
+  EXPECT_EQ(info->criterion, model::ErrorCriterion::kThreshold);
   EXPECT_EQ(info->order_rule, model::OrderRule{});
-  EXPECT_EQ(info->order_rule.selection, model::OrderSelection::kWeighted);
+  EXPECT_EQ(info->order_rule.selection, model::OrderSelection::kMargin);
   EXPECT_EQ(info->lossless_sampling_period, 0);
 }
 

@@ -24,7 +24,7 @@ inline constexpr double kDefaultOrderMargin = 0.001;
 inline constexpr double kDefaultOrderTemperature = 0.01;
 
 struct OrderRule {
-  OrderSelection selection = OrderSelection::kWeighted;
+  OrderSelection selection = OrderSelection::kMargin;
   double margin = kDefaultOrderMargin;            // kMargin only. REQUIRES: finite, ≥ 0
   double temperature = kDefaultOrderTemperature;  // kWeighted only. REQUIRES: finite, > 0
   bool operator==(const OrderRule&) const = default;

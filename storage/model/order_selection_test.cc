@@ -61,8 +61,8 @@ TEST(OrderSelectionTest, NoEvidenceIsOrderZeroForEveryRule) {
   for (const OrderRule& rule : {kPaper, kMargin, OrderRule{}}) EXPECT_EQ(SelectOrder(errors, 0.0, 5, rule), 0);
 }
 
-TEST(OrderSelectionTest, DefaultIsWeighted) {
-  EXPECT_EQ(OrderRule{}.selection, OrderSelection::kWeighted);
+TEST(OrderSelectionTest, DefaultIsTheMarginRule) {
+  EXPECT_EQ(OrderRule{}.selection, OrderSelection::kMargin);
   EXPECT_EQ(OrderRule{}.temperature, kDefaultOrderTemperature);
 }
 

@@ -205,11 +205,11 @@ class Client(AdminCalls):
         `origin` (x, y[, z]) metres; a generic map (states by id or name) otherwise. `kind` ("grid"
         or "generic") may say so explicitly. Model settings left None take the daemon's defaults:
         periods = `period_count` harmonics of `longest_period` seconds (24 of a week), or the
-        explicit list `periods`; `max_order` 5; `persistence` True; `error_half_life` 3 days;
-        `criterion` "squared" or "threshold"; `order_selection` "weighted" (the mean order under
-        weights exp(-(r - r_min)/`order_temperature`), temperature 0.01), "margin" (a higher order must
-        win by `order_margin`, 0.001) or "paper" (the exact minimum); `lossless_sampling` seconds (0 = no lossless
-        history); `shards` 0 = the daemon's default.
+        explicit list `periods`; `max_order` 5; `persistence` True; `error_half_life` 7 days;
+        `criterion` "threshold" or "squared"; `order_selection` "margin" (the default: a higher order
+        must win by `order_margin`, 0.001), "weighted" (the mean order under weights
+        exp(-(r - r_min)/`order_temperature`), temperature 0.01) or "paper" (the exact minimum);
+        `lossless_sampling` seconds (0 = no lossless history); `shards` 0 = the daemon's default.
         """
         if kind is None:
             kind = "grid" if size is not None else "generic"

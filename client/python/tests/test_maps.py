@@ -24,9 +24,10 @@ class MapsTest(DaemonTestCase):
         self.assertEqual(made.periods, [])
         self.assertEqual(made.max_order, 5)
         self.assertTrue(made.persistence)
-        self.assertEqual(made.criterion, "squared")
-        self.assertEqual(made.error_half_life, 3 * 86400)
-        self.assertEqual(made.order_selection, "weighted")
+        self.assertEqual(made.criterion, "threshold")
+        self.assertEqual(made.error_half_life, 7 * 86400)
+        self.assertEqual(made.order_selection, "margin")
+        self.assertEqual(made.order_margin, 0.001)
         self.assertEqual(made.order_temperature, 0.01)
         self.assertGreater(made.create_time, 1.7e9)
         self.assertEqual(made.proto.grid.size.x, 40)  # the message it came from
