@@ -479,7 +479,7 @@ absl::Status MapStoreImpl::StartTail() {
   // request before this; its record then comes before the snapshot's checkpoint.
   move_.state = MoveState::kCopying;
   base::MutexLock tail(&tail_mutex_);
-  tail_.emplace();
+  tail_ = TailCapture{};  // not emplace(): clang finds a nested struct with member initialisers not default-constructible here
   return absl::OkStatus();
 }
 
