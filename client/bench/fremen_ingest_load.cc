@@ -36,6 +36,7 @@
 
 #include "CLI/CLI.hpp"
 #include "base/compact_scan.h"
+#include "client/bench/load_stats.h"
 #include "fremen/v1/ingest.grpc.pb.h"
 #include "fremen/v1/maps.grpc.pb.h"
 #include "fremen/v1/query.grpc.pb.h"
@@ -43,7 +44,10 @@
 namespace {
 
 namespace v1 = fremen::v1;
-using Clock = std::chrono::steady_clock;
+using fremen::bench::Clock;
+using fremen::bench::Median;
+using fremen::bench::Quantile;
+using fremen::bench::Seconds;
 
 constexpr double kT0 = 1.7e9;
 constexpr double kScanInterval = 0.1;  // seconds between a robot's scans (10 Hz)
@@ -72,19 +76,6 @@ struct Options {
 };
 
 constexpr double kHistoryInterval = 60;  // seconds between a history's observations of a state
-
-double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
-
-// The q-quantile of sorted values.
-double Quantile(const std::vector<double>& sorted, double q) {
-  if (sorted.empty()) return 0;
-  return sorted[std::min(sorted.size() - 1, static_cast<size_t>(q * static_cast<double>(sorted.size())))];
-}
 
 class Client {
  public:

@@ -28,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "client/bench/load_stats.h"
 #include "fremen/v1/admin.grpc.pb.h"
 #include "fremen/v1/ingest.grpc.pb.h"
 #include "fremen/v1/maps.grpc.pb.h"
@@ -36,7 +37,10 @@
 namespace {
 
 namespace v1 = fremen::v1;
-using Clock = std::chrono::steady_clock;
+using fremen::bench::Clock;
+using fremen::bench::Median;
+using fremen::bench::Quantile;
+using fremen::bench::Seconds;
 
 constexpr double kT0 = 1.7e9;
 
@@ -91,17 +95,6 @@ Options Parse(int argc, char** argv) {
   }
   return o;
 }
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-double Percentile(std::vector<double>& sorted, double q) {
-  return sorted[std::min(sorted.size() - 1, static_cast<size_t>(q * static_cast<double>(sorted.size())))];
-}
-
-double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 class Bench {
  public:
@@ -324,7 +317,7 @@ void Bench::Predict() {
   if (!ok) return;
   std::sort(latencies.begin(), latencies.end());
   std::printf("Predict 1 state, 1 in flight:  p50 %.0f µs, p99 %.0f µs, %.0f predictions/s\n",
-              Percentile(latencies, 0.5) * 1e6, Percentile(latencies, 0.99) * 1e6, latencies.size() / elapsed);
+              Quantile(latencies, 0.5) * 1e6, Quantile(latencies, 0.99) * 1e6, latencies.size() / elapsed);
 
   std::vector<std::vector<double>> per_thread(o_.concurrency);
   std::vector<std::thread> threads;
@@ -345,7 +338,7 @@ void Bench::Predict() {
   for (const auto& v : per_thread) all.insert(all.end(), v.begin(), v.end());
   std::sort(all.begin(), all.end());
   std::printf("Predict 1 state, %d in flight: p50 %.0f µs, p99 %.0f µs, %.0f predictions/s\n", o_.concurrency,
-              Percentile(all, 0.5) * 1e6, Percentile(all, 0.99) * 1e6, all.size() / concurrent_elapsed);
+              Quantile(all, 0.5) * 1e6, Quantile(all, 0.99) * 1e6, all.size() / concurrent_elapsed);
 
   const int batch_calls = std::max(1, o_.predict_calls / 20);
   const auto batch_start = Clock::now();
@@ -354,7 +347,7 @@ void Bench::Predict() {
   if (!ok) return;
   std::sort(batches.begin(), batches.end());
   std::printf("Predict %d states a call, 1 in flight: p50 %.0f µs a call, %.0f predictions/s\n", o_.batch,
-              Percentile(batches, 0.5) * 1e6, static_cast<double>(o_.batch) * batches.size() / batch_elapsed);
+              Quantile(batches, 0.5) * 1e6, static_cast<double>(o_.batch) * batches.size() / batch_elapsed);
 }
 
 }  // namespace
