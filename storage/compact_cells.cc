@@ -1,5 +1,7 @@
 #include "storage/compact_cells.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 #include "storage/cell_key.h"
 
@@ -62,6 +64,22 @@ absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& ce
   bool outside = false;  // index ≥ cell_count: this and every later cell
   size_t at = 0;
   for (size_t i = 0; i < n; ++i) {
+    if (i > 0 && !outside && in[at] == 1 && cell[0] + 1 < nx) {
+      // A run of neighbours along x, the bulk of a coherent scan: one byte (gap 1) and one step of
+      // the key's x bits each, up to the row's end, with none of the checks a gap needs.
+      const size_t run_limit = std::min<size_t>(n - i, nx - 1 - cell[0]);
+      size_t run = 1;
+      while (run < run_limit && in[at + run] == 1) ++run;
+      for (size_t r = 0; r < run; ++r) {
+        key = (key & ~x_bits) | (((key | ~x_bits) + 1) & x_bits);
+        keys[i + r] = key;
+      }
+      at += run;
+      index += run;
+      cell[0] += static_cast<uint32_t>(run);
+      i += run - 1;
+      continue;
+    }
     uint64_t gap = in[at++];
     if (gap >= 0x80) {  // the rare long gap: a jump to another part of the grid
       gap &= 0x7f;

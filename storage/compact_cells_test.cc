@@ -61,6 +61,26 @@ TEST(CompactCellsTest, RandomScansExpandToTheKeysOfTheirCellsIn2DAnd3D) {
   }
 }
 
+// A whole-grid sweep (every gap 1, rows ending in the middle of a run of bytes) and a few cells
+// past the grid's end: the run fast path leaves each row at its last cell.
+TEST(CompactCellsTest, AWholeGridSweepExpandsToEveryCellsKeyInOrder) {
+  for (const GridGeometry& grid : {Grid(37, 5, 1), Grid(8, 3, 2), Grid(2, 2, 2), Grid(584, 3, 1)}) {
+    std::vector<uint64_t> indices;
+    std::vector<float> values;
+    for (uint64_t i = 0; i < grid.cell_count() + 3; ++i) {
+      indices.push_back(i);
+      values.push_back(static_cast<float>(i % 3 == 0));
+    }
+    CompactCells cells{EncodeIndexGaps(indices), PackOccupiedBits(values), ""};
+    std::vector<uint64_t> keys, want;
+    std::vector<float> got_values;
+    ASSERT_TRUE(ExpandCompactCells(grid, cells, 1 << 28, keys, got_values).ok());
+    Reference(grid, indices, want);
+    EXPECT_EQ(keys, want) << grid.size[0] << "x" << grid.size[1] << "x" << grid.size[2];
+    EXPECT_EQ(got_values, values);
+  }
+}
+
 TEST(CompactCellsTest, ProbabilitiesAreBytesOver255AsAPatchs) {
   CompactCells cells{EncodeIndexGaps(std::vector<uint64_t>{0, 1, 5}), "", std::string("\x00\x33\xff", 3)};
   std::vector<uint64_t> keys;

@@ -113,6 +113,8 @@ absl::StatusOr<std::unique_ptr<MapStoreImpl>> MapStoreImpl::Open(const MapInfo& 
     }
     store->shards_.push_back(*std::move(shard));
   }
+  // Started before recovery, which applies the log's batches on them.
+  store->workers_ = std::make_unique<ShardWorkers>(info.shards, "fremen-shard");
   const absl::Time recovery_start = absl::Now();
   if (absl::Status s = store->Recover(); !s.ok()) {
     return absl::Status(s.code(), absl::StrCat("map ", info.name, ": recovery: ", s.message()));
@@ -139,7 +141,6 @@ absl::StatusOr<std::unique_ptr<MapStoreImpl>> MapStoreImpl::Open(const MapInfo& 
   } else if (!absl::IsNotFound(incoming.status())) {
     return incoming.status();
   }
-  store->workers_ = std::make_unique<ShardWorkers>(info.shards, "fremen-shard");
   store->committer_ = std::thread([s = store.get()] { s->CommitLoop(); });
   store->applier_ = std::thread([s = store.get()] { s->ApplyLoop(); });
   return store;
@@ -164,9 +165,38 @@ absl::Status MapStoreImpl::Recover() {
     written_lsn_ = from;
     dedup_.MergeFrom(shard->checkpoint_dedup());
   }
+  // Replayed batches are applied in groups, every shard's part on the shard's own thread (as the
+  // committer applies a group), while decoding stays on this thread: a shard that checkpointed
+  // past a record skips it, and a publication's record ends its group, so that every shard folds in
+  // its batches and publications in log order.
+  struct Replayed {
+    uint64_t lsn;
+    Pending pending;
+  };
+  std::vector<Replayed> group;
+  uint64_t group_observations = 0;
+  const auto apply_group = [&]() ABSL_NO_THREAD_SAFETY_ANALYSIS {  // see Recover
+    if (group.empty()) return;
+    std::vector<ScanContext> scans;
+    scans.reserve(group.size());
+    for (const Replayed& r : group) scans.emplace_back(settings_->periods, r.pending.batch.time);
+    workers_->RunOnAll([&](uint32_t s) ABSL_NO_THREAD_SAFETY_ANALYSIS {
+      for (size_t i = 0; i < group.size(); ++i) {
+        if (shards_[s]->checkpoint_lsn() >= group[i].lsn) continue;  // the checkpoint has it already
+        ApplyToShard(s, group[i].pending, scans[i]);
+        shards_[s]->ApplyLabels(group[i].pending.labels[s]);
+      }
+    });
+    group.clear();
+    group_observations = 0;
+  };
+  // A group's decoded batches stay in memory until it is applied: a few tens of MB.
+  constexpr uint64_t kGroupObservations = uint64_t{1} << 21;
+  constexpr size_t kGroupRecords = 512;
   auto replayed = ReplayWal(dir_ + "/wal", from, [&](uint64_t lsn, std::span<const uint8_t> payload)
                                                      ABSL_NO_THREAD_SAFETY_ANALYSIS -> absl::Status {  // see Recover
     if (payload.size() == 1 && payload[0] == kPublishRecord) {
+      apply_group();
       for (const auto& shard : shards_) {
         if (shard->checkpoint_lsn() < lsn) shard->PublishAll();
       }
@@ -185,14 +215,12 @@ absl::Status MapStoreImpl::Recover() {
     Pending pending{*std::move(batch), nullptr, {}, {}, {}, {}, {}, {}, {}, {}};
     pending.ack = Classify(info_, pending.batch, pending.accept);
     SplitByShard(pending);
-    const ScanContext scan(settings_->periods, pending.batch.time);
-    for (uint32_t s = 0; s < shards_.size(); ++s) {
-      if (shards_[s]->checkpoint_lsn() >= lsn) continue;  // the checkpoint has it already
-      ApplyToShard(s, pending, scan);
-      shards_[s]->ApplyLabels(pending.labels[s]);
-    }
+    group_observations += pending.batch.observation_count();
+    group.push_back({lsn, std::move(pending)});
+    if (group_observations >= kGroupObservations || group.size() >= kGroupRecords) apply_group();
     return absl::OkStatus();
   }, options_.env);
+  if (replayed.ok()) apply_group();
   if (!replayed.ok()) return replayed.status();
   // A checkpoint is only written once its records are durable, and the log is dropped only once
   // every shard has it: a shard behind the newest checkpoint whose log stops short of it lacks
@@ -251,7 +279,29 @@ void MapStoreImpl::SplitByShard(Pending& pending) const {
     values[s].reserve(share);
   }
   // A coherent scan's neighbouring keys share their brick, so its shard (a hash and a division) is
-  // computed once per run of the brick's keys.
+  // computed once per run of the brick's keys; a scan's run goes to its shard in one copy when all
+  // of it is accepted.
+  if (!b.is_history()) {
+    const size_t n = b.keys.size();
+    for (size_t i = 0; i < n;) {
+      const uint64_t run_brick = BrickOf(b.keys[i]);
+      size_t end = i + 1;
+      while (end < n && BrickOf(b.keys[end]) == run_brick) ++end;
+      const uint32_t s = ShardOf(b.keys[i], info_.shards);
+      if (std::memchr(&pending.accept[i], 0, end - i) == nullptr) {
+        keys[s].insert(keys[s].end(), b.keys.begin() + static_cast<ptrdiff_t>(i), b.keys.begin() + static_cast<ptrdiff_t>(end));
+        values[s].insert(values[s].end(), b.values.begin() + static_cast<ptrdiff_t>(i),
+                         b.values.begin() + static_cast<ptrdiff_t>(end));
+      } else {
+        for (size_t k = i; k < end; ++k) {
+          if (!pending.accept[k]) continue;
+          keys[s].push_back(b.keys[k]);
+          values[s].push_back(b.values[k]);
+        }
+      }
+      i = end;
+    }
+  }
   uint64_t brick = ~uint64_t{0};
   uint32_t shard = 0;
   // A history's runs: the batch's observations split where the time changes (rejected ones
@@ -262,22 +312,20 @@ void MapStoreImpl::SplitByShard(Pending& pending) const {
     pending.runs.assign(info_.shards, {});
     last_run.assign(info_.shards, 0);
   }
-  for (size_t i = 0; i < b.keys.size(); ++i) {
-    if (b.is_history() && i > 0 && b.times[i] != b.times[i - 1]) ++run;
+  for (size_t i = 0; b.is_history() && i < b.keys.size(); ++i) {
+    if (i > 0 && b.times[i] != b.times[i - 1]) ++run;
     if (!pending.accept[i]) continue;
     if (BrickOf(b.keys[i]) != brick) {
       brick = BrickOf(b.keys[i]);
       shard = ShardOf(b.keys[i], info_.shards);
     }
     const uint32_t s = shard;
-    if (b.is_history()) {
-      const uint32_t end = static_cast<uint32_t>(keys[s].size()) + 1;
-      if (last_run[s] == run + 1) {
-        pending.runs[s].back().end = end;
-      } else {
-        pending.runs[s].push_back({b.times[i], end});
-        last_run[s] = run + 1;
-      }
+    const uint32_t end = static_cast<uint32_t>(keys[s].size()) + 1;
+    if (last_run[s] == run + 1) {
+      pending.runs[s].back().end = end;
+    } else {
+      pending.runs[s].push_back({b.times[i], end});
+      last_run[s] = run + 1;
     }
     keys[s].push_back(b.keys[i]);
     values[s].push_back(b.values[i]);

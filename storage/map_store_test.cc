@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <filesystem>
 #include <random>
 #include <thread>
 
@@ -111,6 +112,32 @@ TEST(MapStoreTest, RestartRecoversFromCheckpointAndLogToTheSameModels) {
   auto retry = reopened->Write(SweepScan(map, 1, 299, 200));
   ASSERT_TRUE(retry.ok());
   EXPECT_TRUE(retry->duplicate);  // the dedup table survived too
+}
+
+// Recovery applies the log in groups of batches (every shard on its own thread), a publication
+// ending its group: a log of many groups, publications among them, replays to the models of a
+// store that applied the same batches live.
+TEST(MapStoreTest, ALogOfManyGroupsReplaysToTheSameModels) {
+  TempDir dir, image_dir, reference_dir;
+  const MapInfo map = GridMap("m", 24, 24, 3, 2);
+  StoreOptions never;
+  never.checkpoint_log_bytes = UINT64_MAX;  // everything stays in the log
+  auto reference = OpenOrDie(map, reference_dir.path());
+  auto store = OpenOrDie(map, dir.path(), never);
+  for (uint64_t i = 0; i < 1500; ++i) {  // about three groups of 512 records
+    ASSERT_TRUE(store->Write(SweepScan(map, 1, i, 100)).ok());
+    ASSERT_TRUE(reference->Write(SweepScan(map, 1, i, 100)).ok());
+    if (i == 200 || i == 511 || i == 1100) {
+      ASSERT_TRUE(store->PublishModels().ok());
+      ASSERT_TRUE(reference->PublishModels().ok());
+    }
+  }
+  // A crash image: the files as they are while the store is open, every batch acknowledged and so
+  // in the log, no checkpoint since the map was created.
+  std::filesystem::copy(dir.path(), image_dir.path() + "/map", std::filesystem::copy_options::recursive);
+  auto recovered = OpenOrDie(map, image_dir.path() + "/map", never);
+  EXPECT_EQ(recovered->Stats().totals.observations, reference->Stats().totals.observations);
+  ExpectSameModels(*recovered, *reference, map);
 }
 
 TEST(MapStoreTest, PredictionsMatchTheModelsAndRegionsMatchPoints) {

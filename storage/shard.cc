@@ -95,6 +95,23 @@ uint32_t Shard::FindOrAddSlot(uint64_t key) {
   return slot;
 }
 
+void Shard::ReserveSlots(std::span<const uint64_t> keys, uint32_t* slots) {
+  // ReserveSlot's work with its brick looked up once per run of the brick's keys (a coherent
+  // scan's neighbours); only a new run of 64 goes out of line.
+  uint64_t brick_id = ~uint64_t{0};
+  Brick* brick = nullptr;  // valid until the next BrickFor, which alone adds bricks
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const uint64_t key = keys[i];
+    if (BrickOf(key) != brick_id) {
+      brick_id = BrickOf(key);
+      brick = &BrickFor(key);
+    }
+    const uint32_t local = key & 511;
+    const uint32_t base = brick->chunk_base[local / kChunk];
+    slots[i] = base != kNone ? base + local % kChunk : ReserveSlot(key);
+  }
+}
+
 uint32_t Shard::ReserveSlot(uint64_t key) {
   const uint32_t local = key & 511;
   uint32_t& base = BrickFor(key).chunk_base[local / kChunk];
@@ -173,7 +190,7 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
   // the slot records fetched a few cells ahead: a scan's slots are cold, and a miss per cell would
   // cost more than all the arithmetic.
   scan_slots_.resize(keys.size());
-  for (size_t i = 0; i < keys.size(); ++i) scan_slots_[i] = ReserveSlot(keys[i]);
+  ReserveSlots(keys, scan_slots_.data());
   constexpr size_t kAhead = 8;
   for (size_t i = 0; i < keys.size(); ++i) {
     if (i + kAhead < keys.size()) __builtin_prefetch(&slots_[scan_slots_[i + kAhead]], 1, 3);

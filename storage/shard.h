@@ -172,6 +172,8 @@ class Shard {
   uint32_t FindOrAddSlot(uint64_t key) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // The slot a key has or will have (allocating its run of 64), without touching the slot itself.
   uint32_t ReserveSlot(uint64_t key) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // ReserveSlot of every key into slots[i].
+  void ReserveSlots(std::span<const uint64_t> keys, uint32_t* slots) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   void SetHandle(uint64_t key, uint32_t handle) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_) {
     BrickFor(key).handles[key & 511] = handle;
   }

@@ -6,18 +6,6 @@
 
 namespace fremen::model {
 
-void StaticState::Observe(double t, float s) {
-  if (count() == 0) {
-    t_first = t;
-    span = 0;
-  } else {
-    const double last = std::max(t_last(), t);
-    t_first = std::min(t_first, t);
-    span = static_cast<float>(last - t_first);
-  }
-  count_value = ((count() + 1) << 1) | (s == 1.0f ? 1u : 0u);
-}
-
 namespace {
 // The mean of e^{-jω t_i} over n times evenly spread over [t0, t0 + span]: a geometric series.
 std::complex<double> MeanPhasorOfEvenTimes(double period, double t0, double span, uint32_t n) {

@@ -9,6 +9,7 @@
 // average out anyway). Thread-safety: a value type.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 
 #include "storage/model/state_model.h"
@@ -35,6 +36,19 @@ struct StaticState {
 
   bool operator==(const StaticState&) const = default;
 };
+// Inline: the write path calls it for most observations of a mostly static map.
+inline void StaticState::Observe(double t, float s) {
+  if (count() == 0) {
+    t_first = t;
+    span = 0;
+  } else {
+    const double last = std::max(t_last(), t);
+    t_first = std::min(t_first, t);
+    span = static_cast<float>(last - t_first);
+  }
+  count_value = ((count() + 1) << 1) | (s == 1.0f ? 1u : 0u);
+}
+
 static_assert(sizeof(StaticState) == 16);
 
 extern template void StaticState::Promote(const ModelSettings&, BasicStateModel<float>&) const;
