@@ -1,10 +1,7 @@
 #include "tests/fremend_fixture.h"
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <signal.h>
 #include <stdlib.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -33,23 +30,6 @@ constexpr auto kPollInterval = std::chrono::milliseconds(20);
 int ExitCodeOf(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
 
 }  // namespace
-
-std::string FreeLoopbackAddress() {
-  // Bind port 0, read the port the kernel chose, release it. Another process could take it before
-  // the daemon binds it; on a test machine that is rare, and the daemon's start then fails loudly.
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  address.sin_port = 0;
-  socklen_t length = sizeof address;
-  if (fd < 0 || bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
-      getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
-    abort();
-  }
-  close(fd);
-  return absl::StrCat("127.0.0.1:", ntohs(address.sin_port));
-}
 
 std::optional<TestCertificate> MakeTestCertificate(const TempDir& dir) {
   TestCertificate made{dir.Path("cert.pem"), dir.Path("key.pem"), ""};

@@ -25,13 +25,10 @@
 #include "absl/status/statusor.h"
 #include "gtest/gtest.h"
 #include "testing/temp_dir.h"
+#include "tests/free_port.h"
 #include "tests/process_runner.h"
 
 namespace fremen::testing {
-
-// A loopback port free at the time of the call ("127.0.0.1:PORT"), for a daemon that must come back
-// on the same address after a restart.
-std::string FreeLoopbackAddress();
 
 // A self-signed certificate for 127.0.0.1 and localhost, made with the openssl command line into
 // `dir` (cert.pem, key.pem). nullopt when openssl cannot make one (the test then skips).
