@@ -195,10 +195,21 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
   for (size_t i = 0; i < keys.size(); ++i) {
     if (i + kAhead < keys.size()) __builtin_prefetch(&slots_[scan_slots_[i + kAhead]], 1, 3);
     const uint32_t slot = scan_slots_[i];
-    slots_[slot].observed = 1;
+    Slot& cell = slots_[slot];
+    cell.observed = 1;
     MarkDirty(slot);
-    uint32_t d = slots_[slot].dynamic;
+    uint32_t d = cell.dynamic;
     if (d == kNone) {
+      // Most cells of a mostly static map: a never-changed state seen before, observed again
+      // with its value and not before its last observation. StaticState::Observe's result for
+      // that case, without its branches (equal to the bit: the span from the same subtraction).
+      model::StaticState& state = cell.static_state;
+      const uint32_t count_value = state.count_value;
+      if (!lossless_ && count_value >= 2 && values[i] == static_cast<float>(count_value & 1u) && t >= state.t_last()) {
+        state.span = static_cast<float>(t - state.t_first);
+        state.count_value = count_value + 2;
+        continue;
+      }
       if (!lossless_ && slots_[slot].static_state.Accepts(values[i])) {
         // Only a state's first observation sets its handle: later ones repeat the same value.
         if (slots_[slot].static_state.count() == 0) SetHandle(keys[i], kStaticHandle | (values[i] == 1.0f ? 1u : 0u));
