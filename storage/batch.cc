@@ -124,7 +124,8 @@ BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector
       bad += static_cast<size_t>(!ValueOk(batch.values[i])) | static_cast<size_t>(batch.keys[i] == kNotACellKey);
     }
   }
-  for (size_t i = 0; (!from_grid || bad > 0) && i < batch.keys.size(); ++i) {
+  const bool check_each = !from_grid || bad > 0;
+  for (size_t i = 0; check_each && i < batch.keys.size(); ++i) {
     if (!ValueOk(batch.values[i])) {
       reject(i, RejectReason::kValueOutOfRange);
     } else if (from_grid) {

@@ -210,10 +210,10 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
         state.count_value = count_value + 2;
         continue;
       }
-      if (!lossless_ && slots_[slot].static_state.Accepts(values[i])) {
+      if (!lossless_ && state.Accepts(values[i])) {
         // Only a state's first observation sets its handle: later ones repeat the same value.
-        if (slots_[slot].static_state.count() == 0) SetHandle(keys[i], kStaticHandle | (values[i] == 1.0f ? 1u : 0u));
-        slots_[slot].static_state.Observe(t, values[i]);
+        if (state.count() == 0) SetHandle(keys[i], kStaticHandle | (values[i] == 1.0f ? 1u : 0u));
+        state.Observe(t, values[i]);
         continue;
       }
       d = Promote(slot);
