@@ -2,7 +2,8 @@
 // fremend: a map fed histories and a map fed the same observations one scan per time end with
 // bit-identical models, statistics and predictions, before and after the update job and after a
 // kill -9 (the log replays a history exactly); a retried history is a duplicate as a whole; bad
-// histories are refused naming the field while the stream goes on.
+// histories are refused naming the field while the stream goes on; a history without values labels
+// its state.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -309,6 +310,34 @@ TEST_F(IngestHistoryTest, BadHistoriesAreRefusedNamingTheFieldAndTheStreamGoesOn
   ASSERT_EQ(on_grid.size(), 1u);
   EXPECT_EQ(on_grid[0].error().code(), static_cast<int>(grpc::StatusCode::INVALID_ARGUMENT));
   EXPECT_THAT(on_grid[0].error().message(), HasSubstr("history observations are only for generic maps"));
+}
+
+// A history of one state without values only labels the state. The daemon once read the label's
+// key from the (empty) observations and died of it: now the state is listed and the stream goes on.
+TEST_F(IngestHistoryTest, AOneStateHistoryWithoutValuesLabelsItsStateAndTheStreamGoesOn) {
+  Create("doors");
+  v1::IngestRequest empty = Request("doors", 1);
+  empty.mutable_history()->add_ids(77);
+  empty.mutable_history()->add_names("cellar door");
+  empty.mutable_history()->add_groups("doors");
+  v1::IngestRequest next = Request("doors", 2);
+  next.mutable_history()->add_times(1.7e9);
+  next.mutable_history()->add_values(1.0f);
+  next.mutable_history()->add_ids(77);
+  const std::vector<v1::IngestResponse> responses = Send({empty, next});
+  ASSERT_EQ(responses.size(), 2u);
+  EXPECT_FALSE(responses[0].has_error()) << responses[0].error().message();
+  EXPECT_EQ(responses[0].accepted(), 0u);
+  EXPECT_FALSE(responses[1].has_error()) << responses[1].error().message();
+  EXPECT_EQ(responses[1].accepted(), 1u);
+  v1::ListStatesRequest list;
+  list.set_map("doors");
+  v1::ListStatesResponse listed;
+  ASSERT_TRUE(query_->ListStates(CallContext().get(), list, &listed).ok());
+  ASSERT_EQ(listed.states_size(), 1);
+  EXPECT_EQ(listed.states(0).id(), 77u);
+  EXPECT_EQ(listed.states(0).name(), "cellar door");
+  EXPECT_EQ(listed.states(0).group(), "doors");
 }
 
 }  // namespace

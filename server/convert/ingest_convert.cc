@@ -209,14 +209,17 @@ absl::Status FromHistory(const v1::IngestRequest& request, ObservationBatch& bat
     }
     keys[i] = by_name ? storage::StateIdOfName(history.names(i)) : history.ids(i);
   }
+  // One state's key is kept apart from batch.keys: a history without values labels its state all
+  // the same, and then batch.keys is empty.
+  const uint64_t only_key = ids == 1 ? keys[0] : 0;
   if (ids == 1) {
-    batch.keys.assign(n, keys[0]);
+    batch.keys.assign(n, only_key);
   } else {
     batch.keys = std::move(keys);
   }
   CopyValues(history.values(), batch);
   return AddLabels("history", history.names(), history.groups(),
-                   [&](int i) { return ids == 1 ? batch.keys[0] : batch.keys[i]; }, batch);
+                   [&](int i) { return ids == 1 ? only_key : batch.keys[i]; }, batch);
 }
 
 // x·y·z, saturated: a patch of 2^32 cells along each axis must not wrap around to a small count.

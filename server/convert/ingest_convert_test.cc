@@ -326,6 +326,24 @@ TEST(IngestConvertTest, OneStatesHistoryGivesEveryObservationItsIdAndTime) {
   EXPECT_TRUE(storage::ValidateBatch(Generic(), *batch).ok());
 }
 
+// A fuzzer's finding: with no values there are no keys to take the label's from.
+TEST(IngestConvertTest, AOneStateHistoryWithoutValuesStillLabelsItsState) {
+  v1::IngestRequest request = History({});
+  request.mutable_history()->add_ids(42);
+  request.mutable_history()->add_names("front door");
+  auto batch = BatchFromRequest(Generic(), request);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  EXPECT_TRUE(batch->keys.empty());
+  ASSERT_EQ(batch->labels.size(), 1u);
+  EXPECT_EQ(batch->labels[0].key, 42u);
+  EXPECT_EQ(batch->labels[0].name, "front door");
+  request.mutable_history()->clear_ids();
+  batch = BatchFromRequest(Generic(), request);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  ASSERT_EQ(batch->labels.size(), 1u);
+  EXPECT_EQ(batch->labels[0].key, storage::StateIdOfName("front door"));
+}
+
 TEST(IngestConvertTest, ManyStatesHistoryTakesAnIdPerObservation) {
   v1::IngestRequest request = History({5, 6});
   request.mutable_history()->add_ids(1);
