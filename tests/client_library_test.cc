@@ -13,6 +13,7 @@
 #include "absl/time/clock.h"
 #include "client/lib/client.h"
 #include "tests/client_daemon_test.h"
+#include "tests/delaying_relay.h"
 #include "tests/fremend_fixture.h"
 #include "tests/map_specs.h"
 
@@ -432,6 +433,9 @@ TEST(ClientConnectionTest, BadOptionsNameTheField) {
   options.keepalive_time = absl::Seconds(1);
   EXPECT_THAT(Client::Connect(options).status().message(), HasSubstr("keepalive_time"));
   options.keepalive_time = absl::Seconds(20);
+  options.connect_timeout = absl::Milliseconds(10);
+  EXPECT_THAT(Client::Connect(options).status().message(), HasSubstr("connect_timeout"));
+  options.connect_timeout = absl::Seconds(20);
   options.tls_client_cert_pem = "x";
   EXPECT_THAT(Client::Connect(options).status().message(), HasSubstr("tls_client_key_pem"));
 }
@@ -469,6 +473,24 @@ TEST(ClientConnectionTest, IdempotentCallsRetryUntilTheDaemonComesUp) {
   EXPECT_TRUE(status.ok()) << status.status();
   EXPECT_GE(retries, 1);
   EXPECT_EQ((*daemon)->Stop(), 0);
+}
+
+// A daemon too busy to answer a new connection at once, or a link with a long round trip: the
+// attempt waits for the handshake (connect_timeout) instead of being abandoned and made again,
+// which, cut shorter than the handshake, would never connect before the backoff grew past it.
+TEST(ClientConnectionTest, AHandshakeThatTakesASecondSucceedsAtTheFirstAttempt) {
+  TempDir dir;
+  auto daemon = FremendProcess::Start(dir.Path("data"));
+  ASSERT_TRUE(daemon.ok()) << daemon.status();
+  auto relay = DelayingRelay::Start((*daemon)->address(), absl::Seconds(1));
+  ASSERT_TRUE(relay.ok()) << relay.status();
+  ConnectionOptions options;
+  options.address = (*relay)->address();
+  auto client = Client::Connect(options);
+  ASSERT_TRUE(client.ok());
+  auto status = client->GetServerStatus({.timeout = absl::Seconds(60)});
+  EXPECT_TRUE(status.ok()) << status.status();
+  EXPECT_EQ((*relay)->accepted(), 1) << "connection attempts were abandoned before the handshake could finish";
 }
 
 TEST(ClientConnectionTest, TlsWithTheDaemonsRootCertificate) {

@@ -29,6 +29,9 @@ absl::Status Validate(const ConnectionOptions& o) {
   if (o.keepalive_timeout <= absl::ZeroDuration()) {
     return absl::InvalidArgumentError("keepalive_timeout must be positive");
   }
+  if (o.connect_timeout < absl::Milliseconds(100)) {
+    return absl::InvalidArgumentError("connect_timeout must be at least 100 ms");
+  }
   if (o.retry.multiplier < 1) return absl::InvalidArgumentError("retry.multiplier must be at least 1");
   if (o.retry.jitter < 0 || o.retry.jitter >= 1) return absl::InvalidArgumentError("retry.jitter must be in [0, 1)");
   if (o.retry.initial_backoff <= absl::ZeroDuration() || o.retry.max_backoff < o.retry.initial_backoff) {
@@ -55,7 +58,9 @@ grpc::ChannelArguments ChannelArgumentsOf(const ConnectionOptions& o) {
   // a dead link before its next scan.
   args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
   args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
-  args.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
+  // gRPC reads "min reconnect backoff" as the shortest time a connection attempt is given (its
+  // deadline is the later of this and the next backoff), not as a pause between attempts.
+  args.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, Milliseconds(o.connect_timeout));
   args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, Milliseconds(o.max_reconnect_backoff));
   args.SetMaxReceiveMessageSize(o.max_receive_message_bytes);
   if (!o.tls_server_name_override.empty()) args.SetSslTargetNameOverride(o.tls_server_name_override);

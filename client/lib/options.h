@@ -67,6 +67,11 @@ struct ConnectionOptions {
   // The channel's own reconnect backoff ceiling (gRPC's default is 120 s, too slow for a robot
   // that comes back into range). Default: 5 s.
   absl::Duration max_reconnect_backoff = absl::Seconds(5);
+  // How long one connection attempt may take, TCP connect and HTTP/2 handshake (the server's
+  // SETTINGS) together, before it is abandoned and retried after the backoff. A loaded daemon or a
+  // slow Wi-Fi link can take hundreds of milliseconds; an attempt cut shorter never connects.
+  // Default: 20 s (gRPC's own).
+  absl::Duration connect_timeout = absl::Seconds(20);
   // Largest message received (region chunks stay under 1 MiB; predictions of many states × times
   // can be larger). Default: 64 MiB.
   int max_receive_message_bytes = 64 << 20;
