@@ -140,6 +140,40 @@ TEST(MapStoreTest, ALogOfManyGroupsReplaysToTheSameModels) {
   ExpectSameModels(*recovered, *reference, map);
 }
 
+// A never-changed cell keeps its first and last observation and its count whatever the order of
+// its scans: the fast path for a static cell seen again in time order must leave one observed
+// before its last (a robot's late scan) to the general rule, which moves the first observation
+// back and leaves the last where it was. Several cells a batch, so that they form a run.
+TEST(MapStoreTest, AStaticCellSeenAgainOutOfTimeOrderKeepsItsFirstAndLastObservation) {
+  TempDir dir;
+  const MapInfo map = GridMap("m", 16, 1, 1, 1);
+  auto store = OpenOrDie(map, dir.path());
+  const double t0 = 1.7e9;
+  const double times[] = {t0 + 100, t0 + 200, t0 + 50, t0 + 150, t0 + 300};
+  uint64_t sequence = 0;
+  for (double t : times) {
+    ObservationBatch b;
+    b.writer_id = 1;
+    b.sequence = ++sequence;
+    b.time = t;
+    for (uint32_t x = 0; x < 16; ++x) {
+      b.keys.push_back(map.grid.keys().Key(x, 0, 0));
+      b.values.push_back(x % 2 ? 1.0f : 0.0f);
+    }
+    auto ack = store->Write(std::move(b));
+    ASSERT_TRUE(ack.ok()) << ack.status();
+  }
+  for (uint32_t x = 0; x < 16; ++x) {
+    const auto snapshot = store->Snapshot(map.grid.keys().Key(x, 0, 0));
+    ASSERT_TRUE(snapshot.has_value()) << x;
+    ASSERT_TRUE(snapshot->is_static) << x;
+    EXPECT_EQ(snapshot->static_state.count(), 5u) << x;
+    EXPECT_EQ(snapshot->static_state.value(), x % 2 ? 1.0f : 0.0f) << x;
+    EXPECT_EQ(snapshot->static_state.t_first, t0 + 50) << x;
+    EXPECT_EQ(snapshot->static_state.t_last(), t0 + 300) << x;
+  }
+}
+
 TEST(MapStoreTest, PredictionsMatchTheModelsAndRegionsMatchPoints) {
   TempDir dir;
   const MapInfo map = GridMap("m", 40, 20, 2, 2);

@@ -192,24 +192,40 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
   scan_slots_.resize(keys.size());
   ReserveSlots(keys, scan_slots_.data());
   constexpr size_t kAhead = 8;
-  for (size_t i = 0; i < keys.size(); ++i) {
-    if (i + kAhead < keys.size()) __builtin_prefetch(&slots_[scan_slots_[i + kAhead]], 1, 3);
+  const size_t n = keys.size();
+  for (size_t i = 0; i < n; ++i) {
+    // Most cells of a mostly static map: a never-changed state seen before, observed again with
+    // its value and not before its last observation. StaticState::Observe's result for that case,
+    // without its branches (equal to the bit: the span from the same subtraction), in a loop of
+    // its own over the run of such cells, so that it keeps its few values in registers; it stops
+    // at the first other cell, which the body below takes, in the scan's order.
+    if (!lossless_) {
+      Slot* const slots = slots_.data();  // nothing in this loop resizes slots_
+      const uint32_t* const scan_slots = scan_slots_.data();
+      for (; i < n; ++i) {
+        if (i + kAhead < n) __builtin_prefetch(&slots[scan_slots[i + kAhead]], 1, 3);
+        Slot& cell = slots[scan_slots[i]];
+        model::StaticState& state = cell.static_state;
+        const uint32_t count_value = state.count_value;
+        if (cell.dynamic != kNone || count_value < 2 || values[i] != static_cast<float>(count_value & 1u) ||
+            t < state.t_last()) {
+          break;
+        }
+        cell.observed = 1;
+        if (!cell.dirty) [[unlikely]] MarkDirty(scan_slots[i]);
+        state.span = static_cast<float>(t - state.t_first);
+        state.count_value = count_value + 2;
+      }
+      if (i == n) break;
+    }
+    if (i + kAhead < n) __builtin_prefetch(&slots_[scan_slots_[i + kAhead]], 1, 3);
     const uint32_t slot = scan_slots_[i];
     Slot& cell = slots_[slot];
     cell.observed = 1;
     MarkDirty(slot);
     uint32_t d = cell.dynamic;
     if (d == kNone) {
-      // Most cells of a mostly static map: a never-changed state seen before, observed again
-      // with its value and not before its last observation. StaticState::Observe's result for
-      // that case, without its branches (equal to the bit: the span from the same subtraction).
       model::StaticState& state = cell.static_state;
-      const uint32_t count_value = state.count_value;
-      if (!lossless_ && count_value >= 2 && values[i] == static_cast<float>(count_value & 1u) && t >= state.t_last()) {
-        state.span = static_cast<float>(t - state.t_first);
-        state.count_value = count_value + 2;
-        continue;
-      }
       if (!lossless_ && state.Accepts(values[i])) {
         // Only a state's first observation sets its handle: later ones repeat the same value.
         if (state.count() == 0) SetHandle(keys[i], kStaticHandle | (values[i] == 1.0f ? 1u : 0u));
