@@ -5,7 +5,7 @@
 // cells from the store, bytes on disk per never-changed and per dynamic cell, and recovery time
 // from a crash image taken when the log is at its longest.
 //
-// Usage: fremen_store_bench [--scans N] [--dir DIR] [--only ingest|region]
+// Usage: fremen_store_bench [--scans N] [--dir DIR] [--only ingest|region|recovery]
 //   DIR: where the maps go (default a temp dir); --only: run one part (e.g. under perf).
 #include <algorithm>
 #include <atomic>
@@ -130,6 +130,36 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// Recovery: a crash image taken when the log is at its longest (just before a checkpoint), opened
+// 5 times, each from a fresh copy (the page cache warm: the disk is not what is measured).
+void Recovery(const std::string& base, uint64_t scans) {
+  StoreOptions never;
+  never.checkpoint_log_bytes = UINT64_MAX;
+  auto m = MapStore::Open(Grid("recover"), base + "/recover", never);
+  if (!m.ok()) return (void)std::fprintf(stderr, "%s\n", std::string(m.status().message()).c_str());
+  (void)Ingest(**m, 0, scans, true, kWriters, 4);
+  const uint64_t log_bytes = (*m)->Stats().log_bytes;
+  // The files as they are while the store is open (a crash image): closing would checkpoint.
+  std::filesystem::copy(base + "/recover", base + "/crash-image", std::filesystem::copy_options::recursive);
+  m->reset();
+  std::vector<double> seconds;
+  bool ok = true;
+  for (int rep = 0; rep < 5; ++rep) {
+    const std::string image = base + "/recover-image";
+    std::filesystem::remove_all(image);
+    std::filesystem::copy(base + "/crash-image", image, std::filesystem::copy_options::recursive);
+    const auto start = Clock::now();
+    auto recovered = MapStore::Open(Grid("recover"), image, never);
+    seconds.push_back(Seconds(start, Clock::now()));
+    ok = ok && recovered.ok();
+  }
+  std::printf("recovery from a crash image with %.0f MB of log (%llu scans): %.2f s (median of 5, %.2f-%.2f; "
+              "target <= 1 s) %s\n",
+              log_bytes / 1e6, static_cast<unsigned long long>(scans), Median(seconds),
+              *std::min_element(seconds.begin(), seconds.end()), *std::max_element(seconds.begin(), seconds.end()),
+              ok ? "" : "FAILED");
+}
+
 }  // namespace
 }  // namespace fremen::storage
 
@@ -144,10 +174,11 @@ int main(int argc, char** argv) {
     } else if (has_value && !std::strcmp(argv[i], "--dir")) {
       base = argv[i + 1];
     } else if (has_value && !std::strcmp(argv[i], "--only") &&
-               (!std::strcmp(argv[i + 1], "ingest") || !std::strcmp(argv[i + 1], "region"))) {
+               (!std::strcmp(argv[i + 1], "ingest") || !std::strcmp(argv[i + 1], "region") ||
+                !std::strcmp(argv[i + 1], "recovery"))) {
       only = argv[i + 1];
     } else {
-      std::fprintf(stderr, "usage: fremen_store_bench [--scans N] [--dir DIR] [--only ingest|region]\n");
+      std::fprintf(stderr, "usage: fremen_store_bench [--scans N] [--dir DIR] [--only ingest|region|recovery]\n");
       return 2;
     }
   }
@@ -155,6 +186,7 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   fremen::testing::TempDir temp;
   if (base.empty()) base = temp.path();
+  if (only == "recovery") return Recovery(base, scans), 0;
 
   StoreOptions options;
   options.max_queued_observations = kWriters * 4 * kScanCells;
@@ -241,21 +273,6 @@ int main(int argc, char** argv) {
     }
   }
 
-  // Recovery: a crash image taken when the log is at its longest (just before a checkpoint).
-  {
-    StoreOptions never;
-    never.checkpoint_log_bytes = UINT64_MAX;
-    auto m = MapStore::Open(Grid("recover"), base + "/recover", never);
-    (void)Ingest(**m, 0, scans, true, kWriters, 4);
-    const uint64_t log_bytes = (*m)->Stats().log_bytes;
-    std::filesystem::copy(base + "/recover", base + "/recover-image", std::filesystem::copy_options::recursive);
-    m->reset();
-    std::filesystem::remove_all(base + "/recover");
-    const auto start = Clock::now();
-    auto recovered = MapStore::Open(Grid("recover"), base + "/recover-image", never);
-    const double seconds = Seconds(start, Clock::now());
-    std::printf("recovery from a crash image with %.0f MB of log (%llu scans): %.2f s (target < 60 s) %s\n",
-                log_bytes / 1e6, static_cast<unsigned long long>(scans), seconds, recovered.ok() ? "" : "FAILED");
-  }
+  Recovery(base, scans);
   return 0;
 }
