@@ -13,6 +13,7 @@
 #include <limits>
 
 #include "absl/strings/str_cat.h"
+#include "absl/synchronization/mutex.h"
 #include "absl/time/clock.h"
 
 namespace fremen::storage {
@@ -85,6 +86,11 @@ absl::StatusOr<ChildExit> RunIsolated(const std::function<bool(int fd)>& child,
     return absl::UnavailableError(absl::StrCat("fork: ", std::strerror(error)));
   }
   if (pid == 0) {
+    // Debian's libabsl is built with its debug checks: every absl::Mutex lock consults a global
+    // lock graph under a spin lock, which another thread of the parent may have held at the fork —
+    // held for ever in this copy. Skipping the deadlock detection skips that lock (LmdbEnv's reads
+    // take an absl::Mutex).
+    absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
     CloseAllBut(fds[1]);
     signal(SIGPIPE, SIG_IGN);
     _exit(child(fds[1]) ? 0 : 3);

@@ -8,10 +8,13 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
+#include <atomic>
 #include <string>
+#include <thread>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/synchronization/mutex.h"
 #include "absl/time/clock.h"
 
 namespace fremen::storage {
@@ -89,6 +92,41 @@ TEST(IsolatedChildTest, APassedDeadlineStartsNoChild) {
   EXPECT_TRUE(absl::IsDeadlineExceeded(ended.status())) << ended.status();
   EXPECT_THAT(ended.status().message(), HasSubstr("before the reading process was started"));
   EXPECT_FALSE(called);
+}
+
+}  // namespace
+}  // namespace fremen::storage
+
+namespace fremen::storage {
+namespace {
+
+// A child that takes an absl::Mutex (LmdbEnv's reads do) while another thread of the parent locks
+// and unlocks absl::Mutexes without pause: absl's debug-mode deadlock detection guards its global
+// lock graph with a spin lock that such a thread holds now and then, and a child forked at that
+// moment inherited it held and waited for it forever (a verification that never ended).
+TEST(IsolatedChildTest, AChildTakesAnAbslMutexWhileTheParentsThreadsAreLocking) {
+  std::atomic<bool> stop{false};
+  std::thread locker([&] {
+    absl::Mutex a, b;
+    while (!stop) {
+      absl::MutexLock la(&a);
+      absl::MutexLock lb(&b);
+    }
+  });
+  int hung = 0;
+  for (int i = 0; i < 300 && hung == 0; ++i) {
+    auto ended = RunIsolated(
+        [](int) {
+          absl::Mutex fresh;
+          absl::ReaderMutexLock lock(&fresh);
+          return true;
+        },
+        [](std::string_view) {}, absl::Now() + absl::Seconds(10));
+    if (!ended.ok() || !ended->ok()) ++hung;
+  }
+  stop = true;
+  locker.join();
+  EXPECT_EQ(hung, 0) << "a child waited for a lock it inherited held";
 }
 
 }  // namespace
