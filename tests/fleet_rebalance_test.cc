@@ -167,13 +167,7 @@ class Traffic {
   explicit Traffic(const std::string& proxy) : proxy_(proxy) {}
   // A test that failed before Stop() still ends the threads (a joinable std::thread's destructor
   // would abort the whole test binary).
-  ~Traffic() {
-    stop_ = true;
-    for (std::thread& t : writers_) {
-      if (t.joinable()) t.join();
-    }
-    if (reader_.joinable()) reader_.join();
-  }
+  ~Traffic() { JoinThreads(); }
 
   absl::Status Start() {
     for (int i = 0; i < kMaps; ++i) {
@@ -204,9 +198,7 @@ class Traffic {
 
   // Stops the writers and the reader; every session closed (all its batches acknowledged).
   void Stop() {
-    stop_ = true;
-    for (std::thread& t : writers_) t.join();
-    reader_.join();
+    JoinThreads();
     for (int i = 0; i < kMaps; ++i) {
       if (absl::Status closed = sessions_[i]->Close(); !closed.ok()) Fail(absl::StrCat(MapName(i), ": ", closed.ToString()));
     }
@@ -220,6 +212,13 @@ class Traffic {
   uint64_t reads() const { return reads_; }
 
  private:
+  void JoinThreads() {
+    stop_ = true;
+    for (std::thread& t : writers_) {
+      if (t.joinable()) t.join();
+    }
+    if (reader_.joinable()) reader_.join();
+  }
   void Fail(const std::string& what) {
     failed_ = true;
     base::MutexLock lock(&mutex_);
