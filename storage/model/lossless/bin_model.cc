@@ -85,6 +85,12 @@ double BinModel::SlotValue(uint64_t slot, int order) const {
   return v;
 }
 
+bool BinModel::IsConstant(int order) const {
+  const size_t used = std::min(order < 0 ? order_ : static_cast<size_t>(order), components_.size());
+  return std::all_of(components_.begin(), components_.begin() + used,
+                     [](const BinComponent& c) { return c.a == 0 && c.b == 0; });
+}
+
 double BinModel::Predict(double x, int order) const {
   const size_t used = std::min(order < 0 ? order_ : static_cast<size_t>(order), components_.size());
   double v = alpha0_;

@@ -63,6 +63,10 @@ class BinModel {
   // Unclamped p at `slot` using the first `order` components (-1: the selected order).
   // REQUIRES: order ≤ components().size().
   double SlotValue(uint64_t slot, int order = -1) const;
+  // Whether SlotValue(·, order) is α0 at every slot: the components used all have zero amplitude
+  // (their fma terms add ±0), as a constant signal's do. -1: the selected order.
+  // REQUIRES: order ≤ components().size().
+  bool IsConstant(int order = -1) const;
   // s'(slot) = p(slot) ≥ 0.5 (eq. 9 at c = 0.5) at the selected order.
   bool SlotEstimate(uint64_t slot) const { return SlotValue(slot) >= 0.5; }
   // p at a fractional slot position x = (t − t0)/Δ ≥ 0, clamped, in ordinary floating point: for

@@ -62,9 +62,6 @@ SlotSpectrum SlotSpectrum::Compute(std::span<const SlotState> signal) {
   SlotSpectrum spectrum;
   const size_t n = signal.size();
   spectrum.length_ = n;
-  spectrum.data_.reset(static_cast<double*>(fftw_malloc(sizeof(double) * 2 * (n / 2 + 1))));
-  double* data = spectrum.data_.get();
-
   uint64_t ones = 0;
   for (SlotState s : signal) {
     spectrum.observed_ += s != SlotState::kUnobserved;
@@ -72,6 +69,16 @@ SlotSpectrum SlotSpectrum::Compute(std::span<const SlotState> signal) {
   }
   const double mean = spectrum.observed_ > 0 ? static_cast<double>(ones) / spectrum.observed_ : 0.0;
   spectrum.gamma0_ = mean;
+  // A signal constant wherever it was observed (most cells of a building: walls, floor) is all zeros
+  // once its mean is removed, and so is its transform: the FFT, most of such a cell's update, is
+  // skipped, and no bins are held. Every bin reads +0.0 (FFTW's own zeros would carry arbitrary
+  // signs), so the model's zero-amplitude components have phase 0.
+  if (ones == 0 || ones == spectrum.observed_) {
+    spectrum.all_zero_ = true;
+    return spectrum;
+  }
+  spectrum.data_.reset(static_cast<double*>(fftw_malloc(sizeof(double) * 2 * (n / 2 + 1))));
+  double* data = spectrum.data_.get();
   // Mean removed before the transform rather than after: the same spectrum for k ≥ 1 (a constant has
   // no power there), and a gap filled with 0 instead of γ0 then contributes exactly nothing.
   for (size_t i = 0; i < n; ++i) {
@@ -86,27 +93,29 @@ SlotSpectrum SlotSpectrum::Compute(std::span<const SlotState> signal) {
         data[i] = 0.0;
     }
   }
-  // A signal constant wherever it was observed (most cells of a building: walls, floor) is all zeros
-  // once its mean is removed, and so is its transform: the FFT, most of such a cell's update, is
-  // skipped. Every bin is +0.0 (FFTW's own zeros would carry arbitrary signs), so the model's
-  // zero-amplitude components have phase 0.
-  if (n == 0) return spectrum;
-  if (ones == 0 || ones == spectrum.observed_) {
-    std::fill(data, data + 2 * (n / 2 + 1), 0.0);
-    spectrum.all_zero_ = true;
-    return spectrum;
-  }
   const Plan plan = InPlaceR2cPlan(static_cast<int>(n), data);
   fftw_execute_dft_r2c(plan.get(), data, reinterpret_cast<fftw_complex*>(data));
   return spectrum;
 }
 
+SlotSpectrum SlotSpectrum::Constant(size_t n, uint64_t observed, bool value) {
+  SlotSpectrum spectrum;
+  spectrum.length_ = n;
+  spectrum.observed_ = observed;
+  spectrum.gamma0_ = value ? 1.0 : 0.0;  // ones / observed, exactly
+  spectrum.all_zero_ = true;
+  return spectrum;
+}
+
 std::complex<double> SlotSpectrum::gamma(size_t k) const {
-  if (observed_ == 0) return 0.0;
+  if (all_zero_) return 0.0;
   const double scale = 1.0 / static_cast<double>(observed_);
   return {data_[2 * k] * scale, data_[2 * k + 1] * scale};
 }
 
-double SlotSpectrum::power(size_t k) const { return data_[2 * k] * data_[2 * k] + data_[2 * k + 1] * data_[2 * k + 1]; }
+double SlotSpectrum::power(size_t k) const {
+  if (all_zero_) return 0.0;
+  return data_[2 * k] * data_[2 * k] + data_[2 * k + 1] * data_[2 * k + 1];
+}
 
 }  // namespace fremen::model

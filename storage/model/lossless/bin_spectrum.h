@@ -28,13 +28,17 @@ class SlotSpectrum {
  public:
   // The spectrum of `signal` (n = signal.size() slots). REQUIRES: n < 2^31.
   static SlotSpectrum Compute(std::span<const SlotState> signal);
+  // What Compute gives for n slots of which `observed` > 0 all hold `value`, without the slots: every
+  // bin zero and γ0 = value (exactly 0 or 1). REQUIRES: 0 < observed ≤ n < 2^31.
+  static SlotSpectrum Constant(size_t n, uint64_t observed, bool value);
 
   // n, the number of slots transformed.
   size_t length() const { return length_; }
   // Bins held: 0..n/2.
   size_t bins() const { return length_ / 2 + 1; }
   uint64_t observed() const { return observed_; }
-  // True when every bin is zero: the signal was constant wherever it was observed (no transform ran).
+  // True when every bin is zero: the signal was constant wherever it was observed, or nothing was (no
+  // transform ran).
   bool all_zero() const { return all_zero_; }
   // γ0 (0 when nothing was observed).
   double gamma0() const { return gamma0_; }
@@ -52,7 +56,7 @@ class SlotSpectrum {
   uint64_t observed_ = 0;
   double gamma0_ = 0;
   bool all_zero_ = false;
-  // In-place r2c layout: bin k is (data[2k], data[2k+1]).
+  // In-place r2c layout: bin k is (data[2k], data[2k+1]). Null when all_zero_ (nothing to hold).
   std::unique_ptr<double[], FftwFree> data_;
 };
 

@@ -151,8 +151,14 @@ absl::StatusOr<int> LosslessHistory::Update(int max_order, std::optional<int> or
   const uint64_t m = slot_count();
   if (m == 0) return model_.order();
 
-  std::vector<SlotState> signal(m);
-  ReconstructInto(0, signal);
+  // A constant history (a wall, a floor: most cells of a building) is updated from its toggle
+  // points alone: no slot is reconstructed, transformed or evaluated.
+  const std::optional<bool> constant = ConstantSignal();
+  std::vector<SlotState> signal;
+  if (!constant) {
+    signal.resize(m);
+    ReconstructInto(0, signal);
+  }
 
   // The published P scores the orders on what it had not seen, before it is replaced
   // (docs/model.md, "Order selection").
@@ -161,11 +167,10 @@ absl::StatusOr<int> LosslessHistory::Update(int max_order, std::optional<int> or
   std::vector<uint64_t> errors(max_order + 1, 0);
   const bool can_predict = !model_.components().empty();
   const bool seen_since = coverage_.Count(update_slot_, m) > 0;
-  if (!order && can_predict && seen_since) {
-    SlotPredictor(model_).CountErrors(update_slot_, std::span<const SlotState>(signal).subspan(update_slot_), errors);
-  }
+  if (!order && can_predict && seen_since) ScoreSinceUpdate(signal, errors);
 
-  const SlotSpectrum spectrum = SlotSpectrum::Compute(signal);
+  const uint64_t observed = constant ? coverage_.Count(0, m) : 0;
+  const SlotSpectrum spectrum = constant ? SlotSpectrum::Constant(m, observed, *constant) : SlotSpectrum::Compute(signal);
   const uint64_t first = coverage_.first_point();
   BinModel next = BinModel::FromSpectrum(spectrum, m - 1 - first, max_order);
 
@@ -175,7 +180,8 @@ absl::StatusOr<int> LosslessHistory::Update(int max_order, std::optional<int> or
   } else if (can_predict && !seen_since) {
     chosen = model_.order();  // nothing new to judge by
   } else {
-    if (!can_predict) SlotPredictor(next).CountErrors(0, signal, errors);
+    // A constant signal's new components all have zero amplitude: every order scores alike.
+    if (!can_predict && !constant) SlotPredictor(next).CountErrors(0, signal, errors);
     // The first minimum: ties go to the lower order.
     chosen = static_cast<int>(std::min_element(errors.begin(), errors.end()) - errors.begin());
   }
@@ -183,9 +189,41 @@ absl::StatusOr<int> LosslessHistory::Update(int max_order, std::optional<int> or
   next.set_order(chosen);
 
   model_ = std::move(next);
-  RebuildOutliers(signal);
+  if (constant) {
+    // P is α0 = the constant at every slot (its components have zero amplitude): nothing is wrong.
+    outliers_.Clear();
+  } else {
+    RebuildOutliers(signal);
+  }
   update_slot_ = m;
   return chosen;
+}
+
+std::optional<bool> LosslessHistory::ConstantSignal() const {
+  if (!model_.IsConstant()) return std::nullopt;  // s' varies: only the slots can tell
+  const uint64_t m = slot_count();
+  const bool estimate = model_.alpha0() >= 0.5;
+  const uint64_t wrong = CountCommon(outliers_, coverage_, 0, m);
+  if (wrong == 0) return estimate;
+  if (wrong == coverage_.Count(0, m)) return !estimate;
+  return std::nullopt;
+}
+
+void LosslessHistory::ScoreSinceUpdate(std::span<const SlotState> signal, std::span<uint64_t> errors) const {
+  const uint64_t m = slot_count();
+  const int held = std::min<int>(static_cast<int>(model_.components().size()), static_cast<int>(errors.size()) - 1);
+  // Components of zero amplitude leave p at α0 at every order: all orders score alike.
+  if (signal.empty() && model_.IsConstant(held)) return;
+  std::vector<SlotState> tail;
+  std::span<const SlotState> since;
+  if (signal.empty()) {
+    tail.resize(m - update_slot_);
+    ReconstructInto(update_slot_, tail);
+    since = tail;
+  } else {
+    since = signal.subspan(update_slot_);
+  }
+  SlotPredictor(model_).CountErrors(update_slot_, since, errors);
 }
 
 void LosslessHistory::RebuildOutliers(std::span<const SlotState> signal) {

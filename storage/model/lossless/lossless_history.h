@@ -126,6 +126,13 @@ class LosslessHistory {
 
  private:
   LosslessHistory(double t0, double delta) : t0_(t0), delta_(delta) {}
+  // The value every observed slot holds, when P's estimate is the same at every slot and O marks none
+  // or all of the observed slots; nullopt otherwise. O(toggle points).
+  std::optional<bool> ConstantSignal() const;
+  // Adds to errors[l] the wrong estimates of the published P at order l on the slots observed since
+  // the last update (SlotPredictor::CountErrors). `signal` is all m slots, or empty for a constant
+  // history: then only what the scores need is reconstructed.
+  void ScoreSinceUpdate(std::span<const SlotState> signal, std::span<uint64_t> errors) const;
   // Rebuilds O from scratch against the current P so that `signal` (all m slots) is reproduced.
   void RebuildOutliers(std::span<const SlotState> signal);
 

@@ -1,8 +1,10 @@
 #include "storage/model/lossless/lossless_history.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -241,6 +243,92 @@ TEST(LosslessHistory, FixedOrderAndUpdatesWithoutNewData) {
   EXPECT_EQ(*h.Update(0), 0);
   EXPECT_TRUE(h.model().components().empty());
   ExpectExact(h, truth);
+}
+
+// P as Update publishes it for `h` by docs/model.md's rule, computed from every reconstructed slot:
+// the reference the update of a constant history, which reconstructs none, must match.
+BinModel ModelFromSlots(const LosslessHistory& h, int max_order) {
+  const uint64_t m = h.slot_count();
+  const Truth signal = *h.Reconstruct(0, m);
+  std::vector<uint64_t> errors(max_order + 1, 0);
+  const bool can_predict = !h.model().components().empty();
+  const bool seen_since = h.coverage().Count(h.update_slot(), m) > 0;
+  if (can_predict && seen_since) {
+    SlotPredictor(h.model()).CountErrors(h.update_slot(), std::span(signal).subspan(h.update_slot()), errors);
+  }
+  BinModel next = BinModel::FromSpectrum(SlotSpectrum::Compute(signal), m - 1 - h.coverage().first_point(), max_order);
+  if (!can_predict) SlotPredictor(next).CountErrors(0, signal, errors);
+  const int chosen = can_predict && !seen_since
+                         ? h.model().order()
+                         : static_cast<int>(std::min_element(errors.begin(), errors.end()) - errors.begin());
+  next.set_order(std::min<int>(chosen, static_cast<int>(next.components().size())));
+  return next;
+}
+
+// Updates `h` and checks it against ModelFromSlots and the truth (of which h holds a prefix).
+void ExpectUpdateMatchesTheSlots(LosslessHistory& h, const Truth& truth, int max_order) {
+  const BinModel expected = ModelFromSlots(h, max_order);
+  ASSERT_TRUE(h.Update(max_order).ok());
+  EXPECT_EQ(h.model(), expected);
+  EXPECT_EQ(h.update_slot(), h.slot_count());
+  const Truth held(truth.begin(), truth.begin() + h.slot_count());
+  ExpectExact(h, held);
+  ExpectErrorsFromOutliersMatchDirectCounts(h, held);
+}
+
+// Every observed slot `value`, with the gaps of PeriodicTruth.
+Truth ConstantTruth(uint64_t n, bool value) {
+  Truth t = PeriodicTruth(n, 0, 1);
+  for (SlotState& s : t) {
+    if (s != SlotState::kUnobserved) s = value ? SlotState::kOccupied : SlotState::kFree;
+  }
+  return t;
+}
+
+TEST(LosslessHistory, ConstantHistoriesUpdateFromTheirTogglePointsAsFromTheirSlots) {
+  for (const bool value : {true, false}) {
+    SCOPED_TRACE(value ? "occupied" : "free");
+    const uint64_t n = 12 * kDay;
+    const Truth truth = ConstantTruth(n, value);
+    LosslessHistory h = NewHistory();
+    AddRange(h, truth, 0, 10 * kDay);
+    ExpectUpdateMatchesTheSlots(h, truth, 5);  // the first: P had no components
+    EXPECT_EQ(h.model().alpha0(), value ? 1.0f : 0.0f);
+    EXPECT_TRUE(h.model().IsConstant());
+    EXPECT_TRUE(h.outliers().empty());
+    ExpectUpdateMatchesTheSlots(h, truth, 5);  // nothing new
+    AddRange(h, truth, 10 * kDay, n);
+    ExpectUpdateMatchesTheSlots(h, truth, 5);  // a new day, scored by zero-amplitude components
+    ExpectUpdateMatchesTheSlots(h, truth, 0);
+  }
+}
+
+TEST(LosslessHistory, AHistoryMadeConstantByLateObservationsUpdatesAsFromItsSlots) {
+  // A dynamic history whose differing slots are all observed again as occupied: P still has
+  // components (at order 0 they are not used by the estimate, but they are scored).
+  const uint64_t n = 6 * kDay;
+  Truth truth = PeriodicTruth(n, 0.02, 3);
+  LosslessHistory h = NewHistory();
+  AddRange(h, truth, 0, 4 * kDay);
+  ASSERT_TRUE(h.Update(5, 0).ok());
+  ASSERT_FALSE(h.model().IsConstant(5));
+  for (SlotState& s : truth) {
+    if (s == SlotState::kFree) s = SlotState::kOccupied;
+  }
+  AddRange(h, truth, 0, n);
+  ExpectUpdateMatchesTheSlots(h, truth, 5);
+  EXPECT_TRUE(h.outliers().empty());
+  // And at an order above 0, where the estimate itself varies: the ordinary path.
+  Truth dynamic = PeriodicTruth(n, 0.02, 4);
+  LosslessHistory d = NewHistory();
+  AddRange(d, dynamic, 0, 4 * kDay);
+  ASSERT_TRUE(d.Update(5, 3).ok());
+  for (SlotState& s : dynamic) {
+    if (s == SlotState::kOccupied) s = SlotState::kFree;
+  }
+  AddRange(d, dynamic, 0, n);
+  ExpectUpdateMatchesTheSlots(d, dynamic, 5);
+  EXPECT_TRUE(d.outliers().empty());
 }
 
 TEST(LosslessHistory, UpdateOfAnEmptyHistoryChangesNothing) {
