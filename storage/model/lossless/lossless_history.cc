@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "absl/strings/str_cat.h"
+#include "storage/model/lossless/slot_estimator.h"
 #include "storage/model/model_settings.h"
 #include "storage/model/observation.h"
 
@@ -12,32 +13,8 @@ namespace fremen::model {
 
 namespace {
 
-// Slots evaluated per step: running values stay in L1.
-constexpr size_t kChunk = 2048;
-// Below this many slots, computing the phasors directly beats building the predictor's tables.
-constexpr size_t kTableThreshold = 4096;
-
-// Whichever way is cheaper for `slots` slots, p at the model's order; both agree to the bit.
-class ValueSource {
- public:
-  ValueSource(const BinModel& model, uint64_t slots) : model_(model) {
-    if (model.order() > 0 && slots >= kTableThreshold) predictor_.emplace(model);
-  }
-  void Values(uint64_t begin, std::span<double> out) const {
-    if (predictor_) {
-      predictor_->Values(begin, model_.order(), out);
-    } else if (model_.order() == 0) {
-      // What SlotValue gives at order 0, without a call per slot: most cells of a building.
-      std::fill(out.begin(), out.end(), static_cast<double>(model_.alpha0()));
-    } else {
-      for (size_t i = 0; i < out.size(); ++i) out[i] = model_.SlotValue(begin + i);
-    }
-  }
-
- private:
-  const BinModel& model_;
-  std::optional<SlotPredictor> predictor_;
-};
+// Slots estimated per step: the estimates stay in L1.
+constexpr size_t kChunk = SlotEstimator::kChunk;
 
 }  // namespace
 
@@ -110,9 +87,9 @@ void LosslessHistory::ReconstructInto(uint64_t begin, std::span<SlotState> out) 
   std::fill(out.begin(), out.end(), SlotState::kUnobserved);
   const uint64_t limit = std::min<uint64_t>(begin + out.size(), slot_count());
   if (begin >= limit) return;
-  const ValueSource source(model_, limit - begin);
+  const SlotEstimator estimator(model_);
   SlotSet::Cursor covered(coverage_), outlier(outliers_);
-  double values[kChunk];
+  bool estimates[kChunk];
   uint64_t x = begin;
   while (x < limit) {
     const bool observed = covered.Seek(x);
@@ -123,12 +100,12 @@ void LosslessHistory::ReconstructInto(uint64_t begin, std::span<SlotState> out) 
     }
     for (uint64_t chunk = x; chunk < run_end; chunk += kChunk) {
       const uint64_t chunk_end = std::min<uint64_t>(chunk + kChunk, run_end);
-      source.Values(chunk, std::span<double>(values, chunk_end - chunk));
+      estimator.Estimates(chunk, std::span<bool>(estimates, chunk_end - chunk));
       for (uint64_t y = chunk; y < chunk_end;) {
         const bool flip = outlier.Seek(y);
         const uint64_t o_end = std::min(outlier.next_change(), chunk_end);
         for (; y < o_end; ++y) {
-          const bool state = (values[y - chunk] >= 0.5) != flip;
+          const bool state = estimates[y - chunk] != flip;
           out[y - begin] = state ? SlotState::kOccupied : SlotState::kFree;
         }
       }
@@ -229,16 +206,16 @@ void LosslessHistory::ScoreSinceUpdate(std::span<const SlotState> signal, std::s
 void LosslessHistory::RebuildOutliers(std::span<const SlotState> signal) {
   SlotSet rebuilt;
   bool in_outliers = false;
-  const ValueSource source(model_, signal.size());
-  double values[kChunk];
+  const SlotEstimator estimator(model_);
+  bool estimates[kChunk];
   for (uint64_t chunk = 0; chunk < signal.size(); chunk += kChunk) {
     const size_t count = std::min<uint64_t>(kChunk, signal.size() - chunk);
-    source.Values(chunk, std::span<double>(values, count));
+    estimator.Estimates(chunk, std::span<bool>(estimates, count));
     for (size_t i = 0; i < count; ++i) {
       const SlotState s = signal[chunk + i];
       if (s == SlotState::kUnobserved) continue;
       // A toggle only where agreement changes between consecutive observations (eq. 8).
-      const bool wrong = (values[i] >= 0.5) != (s == SlotState::kOccupied);
+      const bool wrong = estimates[i] != (s == SlotState::kOccupied);
       if (wrong != in_outliers) {
         rebuilt.Toggle(chunk + i);
         in_outliers = wrong;
