@@ -113,9 +113,4 @@ std::complex<double> SlotSpectrum::gamma(size_t k) const {
   return {data_[2 * k] * scale, data_[2 * k + 1] * scale};
 }
 
-double SlotSpectrum::power(size_t k) const {
-  if (all_zero_) return 0.0;
-  return data_[2 * k] * data_[2 * k] + data_[2 * k + 1] * data_[2 * k + 1];
-}
-
 }  // namespace fremen::model

@@ -45,7 +45,11 @@ class SlotSpectrum {
   // γ_k for k in [1, n/2] (γ_0 of the mean-removed signal is 0: use gamma0()).
   std::complex<double> gamma(size_t k) const;
   // |Σ_observed (s_i − γ0) e^{−j2πki/n}|², which orders bins like |γ_k| without a division.
-  double power(size_t k) const;
+  // Inline: the bin scan of BinModel::FromSpectrum calls it for every bin.
+  double power(size_t k) const {
+    if (all_zero_) return 0.0;
+    return data_[2 * k] * data_[2 * k] + data_[2 * k + 1] * data_[2 * k + 1];
+  }
 
  private:
   SlotSpectrum() = default;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "storage/model/kernels/cpu_dispatch.h"
 
@@ -9,31 +10,38 @@ namespace fremen::model {
 
 namespace {
 
-// Slots advanced together by the recurrence: one vector multiply per component and group.
-constexpr size_t kLanes = 8;
+// Slots advanced together by the recurrence: two vectors of four doubles (GCC's vector extension,
+// so that the portable build gets SSE2 pairs and the AVX2 clone whole vectors).
+using Vec = double __attribute__((vector_size(32)));
+constexpr size_t kWidth = 4;
+constexpr size_t kLanes = 2 * kWidth;
 static_assert(SlotEstimator::kChunk % kLanes == 0);
 
-// The product of two phasors in ordinary arithmetic (contraction allowed: only the bound matters).
-inline void Multiply(double& re, double& im, double wr, double wi) {
-  const double r = re * wr - im * wi;
-  im = re * wi + im * wr;
-  re = r;
-}
-
-// v[i] += Re(c·e^{jθ(begin + i)}) for i < count (rounded up to whole groups of kLanes; v holds them),
-// from `seed` = e^{jθ·begin}. Cloned for AVX2 (cpu_dispatch.h): the lanes are one vector.
+// v[i] += Re(c·e^{jθ(begin + i)}) for i < count (a whole number of groups of kLanes), from
+// `seed` = e^{jθ·begin}. Ordinary arithmetic (contraction allowed): only the bound matters.
+// Cloned for AVX2 (cpu_dispatch.h).
 FREMEN_KERNEL_CLONES void AddApproximate(const BinComponent& c, UnitPhasor seed, UnitPhasor step, UnitPhasor leap,
                                          size_t count, double* v) {
-  double re[kLanes], im[kLanes];
+  Vec re[2], im[2];
   double zr = c.a * seed.cos - c.b * seed.sin, zi = c.a * seed.sin + c.b * seed.cos;
   for (size_t l = 0; l < kLanes; ++l) {
-    re[l] = zr;
-    im[l] = zi;
-    Multiply(zr, zi, step.cos, step.sin);
+    re[l / kWidth][l % kWidth] = zr;
+    im[l / kWidth][l % kWidth] = zi;
+    const double r = zr * step.cos - zi * step.sin;
+    zi = zr * step.sin + zi * step.cos;
+    zr = r;
   }
+  const Vec wr = {leap.cos, leap.cos, leap.cos, leap.cos}, wi = {leap.sin, leap.sin, leap.sin, leap.sin};
   for (size_t i = 0; i < count; i += kLanes) {
-    for (size_t l = 0; l < kLanes; ++l) v[i + l] += re[l];
-    for (size_t l = 0; l < kLanes; ++l) Multiply(re[l], im[l], leap.cos, leap.sin);
+    for (size_t h = 0; h < 2; ++h) {
+      Vec x;
+      std::memcpy(&x, v + i + h * kWidth, sizeof x);
+      x += re[h];
+      std::memcpy(v + i + h * kWidth, &x, sizeof x);
+      const Vec r = re[h] * wr - im[h] * wi;
+      im[h] = re[h] * wi + im[h] * wr;
+      re[h] = r;
+    }
   }
 }
 
@@ -68,23 +76,25 @@ size_t SlotEstimator::Estimates(uint64_t begin, std::span<bool> out) const {
 
 size_t SlotEstimator::ChunkEstimates(uint64_t begin, std::span<bool> out) const {
   const uint64_t n = model_.length();
-  const size_t groups = (out.size() + kLanes - 1) / kLanes * kLanes;
+  const size_t whole = (out.size() + kLanes - 1) / kLanes * kLanes;  // whole groups of lanes
   double v[kChunk];
-  std::fill(v, v + groups, static_cast<double>(model_.alpha0()));
+  std::fill(v, v + whole, static_cast<double>(model_.alpha0()));
   for (const Component& c : components_) {
-    AddApproximate(c.c, BinPhasor(AngleIndex(c.c.k, begin, n), n), c.step, c.leap, groups, v);
+    AddApproximate(c.c, BinPhasor(AngleIndex(c.c.k, begin, n), n), c.step, c.leap, whole, v);
+  }
+  // Decided by the approximation, branch-free; then the slots too close to call (or not a number),
+  // if any, by the record's own arithmetic.
+  bool unsure = false;
+  for (size_t i = 0; i < out.size(); ++i) {
+    out[i] = v[i] >= 0.5;
+    unsure |= !(std::fabs(v[i] - 0.5) > bound_);
   }
   size_t exact = 0;
+  if (!unsure) return exact;
   for (size_t i = 0; i < out.size(); ++i) {
-    const double d = v[i] - 0.5;
-    if (d > bound_) {
-      out[i] = true;
-    } else if (d < -bound_) {
-      out[i] = false;
-    } else {  // too close to call (or not a number): the record's own arithmetic decides
-      out[i] = model_.SlotValue(begin + i) >= 0.5;
-      ++exact;
-    }
+    if (std::fabs(v[i] - 0.5) > bound_) continue;
+    out[i] = model_.SlotValue(begin + i) >= 0.5;
+    ++exact;
   }
   return exact;
 }
