@@ -9,7 +9,9 @@
 //     while the checkpoint after it writes the 1M republished states.
 //  4. lossless: the update of one state with 30 days of 5-s history plus a new day (17,280 slots),
 //     measured on --lossless-states copies and extrapolated to 10k cells on 2 cores: every cell
-//     dynamic, and 1 in 20 dynamic with the rest constant (a building: the constant ones skip the FFT).
+//     dynamic, and 1 in 20 dynamic with the rest constant (a building: the constant ones skip the FFT);
+//     beside them the FFT alone of the dynamic states (SlotSpectrum::Compute), a full-length
+//     update's ceiling.
 // Medians of --runs runs (default 3). Run it with `nice -n 10` on a shared machine.
 //
 // Usage: fremen_update_bench [--runs N] [--lossless-states N] [--lossless-mix MIX] [--dir DIR] [--parts DIGITS]
@@ -29,6 +31,7 @@
 #include <vector>
 
 #include "storage/map_store.h"
+#include "storage/model/lossless/bin_spectrum.h"
 #include "storage/model/lossless/lossless_history.h"
 #include "testing/temp_dir.h"
 
@@ -153,6 +156,20 @@ double LosslessNight(const std::vector<model::LosslessHistory>& cells) {
   return Seconds(start, Clock::now()) / static_cast<double>(copies.size());
 }
 
+// Seconds per state of the transform alone (SlotSpectrum::Compute of the reconstructed signal) of
+// `cells` on 2 threads: the ceiling of a full-length update, measured beside it.
+double TransformOnly(const std::vector<model::LosslessHistory>& cells) {
+  std::vector<std::vector<model::SlotState>> signals;
+  for (const auto& cell : cells) signals.push_back(*cell.Reconstruct(0, cell.slot_count()));
+  const auto start = Clock::now();
+  std::thread other([&] {
+    for (size_t i = 1; i < signals.size(); i += 2) (void)model::SlotSpectrum::Compute(signals[i]);
+  });
+  for (size_t i = 0; i < signals.size(); i += 2) (void)model::SlotSpectrum::Compute(signals[i]);
+  other.join();
+  return Seconds(start, Clock::now()) / static_cast<double>(signals.size());
+}
+
 }  // namespace
 }  // namespace fremen::storage
 
@@ -263,8 +280,9 @@ int main(int argc, char** argv) {
     std::vector<fremen::model::LosslessHistory> worst(lossless_states, dynamic), office;
     for (int i = 0; i < lossless_states; ++i) office.push_back(i % 20 == 0 ? dynamic : wall);
     const bool all_dynamic = mix != "office", office_mix = mix != "dynamic";
-    std::vector<double> worst_s, office_s;
+    std::vector<double> worst_s, office_s, transform_s;
     for (int r = 0; r < runs; ++r) {
+      if (all_dynamic) transform_s.push_back(TransformOnly(worst));
       if (all_dynamic) worst_s.push_back(LosslessNight(worst));
       if (office_mix) office_s.push_back(LosslessNight(office));
     }
@@ -272,8 +290,9 @@ int main(int argc, char** argv) {
                 "runs on %d states (target: 10k cells <= 15 s; the paper: < 1 min per night):\n",
                 static_cast<unsigned long long>(dynamic.slot_count()), runs, lossless_states);
     if (all_dynamic) {
-      std::printf("  every cell dynamic: %.2f ms per state -> 10k cells: %.1f s\n", Median(worst_s) * 1e3,
-                  Median(worst_s) * 1e4);
+      std::printf("  every cell dynamic: %.2f ms per state -> 10k cells: %.1f s (ceiling in the same runs, the FFT "
+                  "alone: %.2f ms per state -> %.1f s)\n",
+                  Median(worst_s) * 1e3, Median(worst_s) * 1e4, Median(transform_s) * 1e3, Median(transform_s) * 1e4);
     }
     if (office_mix) {
       std::printf("  1 cell in 20 dynamic, the rest constant: %.2f ms per state -> 10k cells: %.1f s\n",

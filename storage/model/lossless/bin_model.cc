@@ -175,7 +175,7 @@ SlotPredictor::SlotPredictor(const BinModel& model) : model_(model) {
   for (uint64_t q = 0; q < coarse_.size(); ++q) coarse_[q] = BinPhasor(q << fine_bits_, n);
 }
 
-// Cloned for FMA (cpu_dispatch.h): every slot of every update and reconstruction passes here.
+// Cloned for FMA (cpu_dispatch.h): the order scoring evaluates every slot since the last update here.
 FREMEN_FMA_CLONES void SlotPredictor::AddComponent(size_t j, uint64_t begin, std::span<double> out) const {
   const BinComponent& c = model_.components()[j];
   const uint64_t n = model_.length();
