@@ -28,7 +28,7 @@ count() {
 # Self cost per function, "instructions<TAB>name", for one output file.
 self_costs() {
   callgrind_annotate --inclusive=no --threshold=100 "$1" 2>/dev/null | grep -E '^ *[0-9,]+ ' |
-    sed -E 's/^ *([0-9,]+) +(\( *[0-9.]+%\) +)?/\1\t/; s/ \[[^]]*\]$//; s/\(anonymous namespace\)/(anon)/g' |
+    sed -E 's/^ *([0-9,]+) +(\( *[0-9.]+%\) +)?/\1\t/; s/\t\?\?\?:/\t/; s/ \[[^]]*\]$//; s/\(anonymous namespace\)/(anon)/g' |
     awk -F'\t' '{ ir = $1; gsub(",", "", ir); print ir "\t" $2 }'
 }
 
