@@ -55,6 +55,15 @@ class ShardCheckpointTest : public ::testing::Test {
     return models;
   }
 
+  // Reopens the shard (a restart): every state's model must read back byte for byte.
+  void ExpectTheSameAfterReopening(std::unique_ptr<Shard>& shard) {
+    const std::vector<std::string> before = Models(*shard);
+    shard.reset();
+    shard = Open();
+    ASSERT_NE(shard, nullptr);
+    EXPECT_EQ(Models(*shard), before);
+  }
+
   absl::Status Checkpoint(Shard& shard, uint64_t lsn) { return shard.WriteCheckpoint(shard.PrepareCheckpoint(lsn, {})); }
 
   MapInfo info_;
@@ -80,12 +89,8 @@ TEST_F(ShardCheckpointTest, AfterAPublicationOnlyThePublishedModelsAreWrittenAnd
     ASSERT_TRUE(model::DecodePublishedModel(record, settings_.periods.size(), settings_.max_order).ok()) << key;
   }
   ASSERT_TRUE(shard->WriteCheckpoint(published).ok());
-  const std::vector<std::string> before = Models(*shard);
-  ASSERT_NE(before[0], "");
-
-  shard.reset();
-  shard = Open();
-  EXPECT_EQ(Models(*shard), before);
+  ASSERT_NE(Models(*shard)[0], "");
+  ExpectTheSameAfterReopening(shard);
   EXPECT_EQ(shard->checkpoint_lsn(), 2u);
 }
 
@@ -101,10 +106,7 @@ TEST_F(ShardCheckpointTest, AnObservedStateWritesItsDynamicRecordWithoutThePubli
   ASSERT_TRUE(decoded.ok()) << decoded.status();
   EXPECT_FALSE(decoded->has_published());
   ASSERT_TRUE(shard->WriteCheckpoint(image).ok());
-  const std::vector<std::string> before = Models(*shard);
-  shard.reset();
-  shard = Open();
-  EXPECT_EQ(Models(*shard), before);
+  ExpectTheSameAfterReopening(shard);
 }
 
 TEST_F(ShardCheckpointTest, AFormat2DynamicRecordHoldingItsPublishedModelIsRead) {
@@ -135,10 +137,7 @@ TEST_F(ShardCheckpointTest, AFormat2DynamicRecordHoldingItsPublishedModelIsRead)
   shard->PublishAll();  // nothing touched: publishes nothing
   Observe(*shard, {1.7e9 + 1200});
   ASSERT_TRUE(Checkpoint(*shard, 2).ok());
-  const std::vector<std::string> after = Models(*shard);
-  shard.reset();
-  shard = Open();
-  EXPECT_EQ(Models(*shard), after);
+  ExpectTheSameAfterReopening(shard);
 }
 
 TEST_F(ShardCheckpointTest, APublishedModelWithoutItsStateIsDataLoss) {
