@@ -4,6 +4,7 @@
 // format 2, which holds its published model itself, is still read.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,28 @@ class ShardCheckpointTest : public ::testing::Test {
     EXPECT_EQ(Models(*shard), before);
   }
 
+  // Changes the shard's files behind its back (a restart reads what f left): f gets the dynamic
+  // and the published databases.
+  static absl::Status Rewrite(Shard& shard, const std::function<absl::Status(LmdbTxn&, MDB_dbi, MDB_dbi)>& f) {
+    return shard.env().Write([&](LmdbTxn& txn) -> absl::Status {
+      auto dynamic = txn.Db(sr::kDynamicDb);
+      auto published = txn.Db(sr::kPublishedDb);
+      if (!dynamic.ok()) return dynamic.status();
+      if (!published.ok()) return published.status();
+      return f(txn, *dynamic, *published);
+    });
+  }
+
+  // Every cell observed twice (dynamic), published and checkpointed at LSN 1.
+  std::unique_ptr<Shard> PublishedAndCheckpointed() {
+    auto shard = Open();
+    Observe(*shard, {1.7e9, 1.7e9 + 600});
+    shard->PublishAll();
+    const absl::Status written = Checkpoint(*shard, 1);
+    EXPECT_TRUE(written.ok()) << written;
+    return written.ok() ? std::move(shard) : nullptr;
+  }
+
   absl::Status Checkpoint(Shard& shard, uint64_t lsn) { return shard.WriteCheckpoint(shard.PrepareCheckpoint(lsn, {})); }
 
   MapInfo info_;
@@ -110,26 +133,17 @@ TEST_F(ShardCheckpointTest, AnObservedStateWritesItsDynamicRecordWithoutThePubli
 }
 
 TEST_F(ShardCheckpointTest, AFormat2DynamicRecordHoldingItsPublishedModelIsRead) {
-  auto shard = Open();
-  Observe(*shard, {1.7e9, 1.7e9 + 600});
-  shard->PublishAll();
-  ASSERT_TRUE(Checkpoint(*shard, 1).ok());
+  auto shard = PublishedAndCheckpointed();
+  ASSERT_NE(shard, nullptr);
   const std::vector<std::string> before = Models(*shard);
   // Rewritten as format 2 laid it out: each state's whole model in its dynamic record, no
   // published records.
-  ASSERT_TRUE(shard->env()
-                  .Write([&](LmdbTxn& txn) -> absl::Status {
-                    auto dynamic = txn.Db(sr::kDynamicDb);
-                    auto published = txn.Db(sr::kPublishedDb);
-                    if (!dynamic.ok() || !published.ok()) return absl::InternalError("no database");
-                    for (size_t i = 0; i < keys_.size(); ++i) {
-                      if (absl::Status s = txn.Put(*dynamic, KeyBytes(keys_[i]), Bytes(before[i])); !s.ok()) {
-                        return s;
-                      }
-                    }
-                    return txn.Drop(*published);
-                  })
-                  .ok());
+  ASSERT_TRUE(Rewrite(*shard, [&](LmdbTxn& txn, MDB_dbi dynamic, MDB_dbi published) {
+                for (size_t i = 0; i < keys_.size(); ++i) {
+                  if (absl::Status s = txn.Put(dynamic, KeyBytes(keys_[i]), Bytes(before[i])); !s.ok()) return s;
+                }
+                return txn.Drop(published);
+              }).ok());
   shard.reset();
   shard = Open();
   EXPECT_EQ(Models(*shard), before);
@@ -141,17 +155,11 @@ TEST_F(ShardCheckpointTest, AFormat2DynamicRecordHoldingItsPublishedModelIsRead)
 }
 
 TEST_F(ShardCheckpointTest, APublishedModelWithoutItsStateIsDataLoss) {
-  auto shard = Open();
-  Observe(*shard, {1.7e9, 1.7e9 + 600});
-  shard->PublishAll();
-  ASSERT_TRUE(Checkpoint(*shard, 1).ok());
-  ASSERT_TRUE(shard->env()
-                  .Write([&](LmdbTxn& txn) -> absl::Status {
-                    auto dynamic = txn.Db(sr::kDynamicDb);
-                    if (!dynamic.ok()) return dynamic.status();
-                    return txn.Delete(*dynamic, KeyBytes(keys_[3]));
-                  })
-                  .ok());
+  auto shard = PublishedAndCheckpointed();
+  ASSERT_NE(shard, nullptr);
+  ASSERT_TRUE(Rewrite(*shard, [&](LmdbTxn& txn, MDB_dbi dynamic, MDB_dbi) {
+                return txn.Delete(dynamic, KeyBytes(keys_[3]));
+              }).ok());
   shard.reset();
   auto reopened = Shard::Open(info_, settings_, dir_.path() + "/shard-0", LmdbOptions{});
   ASSERT_TRUE(absl::IsDataLoss(reopened.status())) << reopened.status();
