@@ -34,8 +34,8 @@ absl::Status WriteDataDirFormat(Env* env, const std::string& data_dir) {
 
 absl::Status UnreadableFormatError(const std::string& data_dir, int format) {
   return absl::FailedPreconditionError(absl::StrCat(
-      data_dir, " is data directory format ", format, ", written by a newer fremend; this one reads format ",
-      kDataDirFormat, ". Its maps were left as they are: serve it with the fremend that wrote it."));
+      data_dir, " is data directory format ", format, ", written by a newer fremend; this one reads formats ",
+      kOldestReadableDataDirFormat, " to ", kDataDirFormat, ". Its maps were left as they are: serve it with the fremend that wrote it."));
 }
 
 }  // namespace fremen::storage

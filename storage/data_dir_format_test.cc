@@ -45,7 +45,7 @@ std::vector<MapInfo> TwoMaps(const TempDir& dir) {
 TEST(DataDirFormatTest, ANewDirectoryIsMarkedWithTheFormat) {
   TempDir dir;
   ASSERT_TRUE(Store::Open(dir.path(), {}).ok());
-  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/FORMAT"), "fremen data directory format 2\n");
+  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/FORMAT"), "fremen data directory format 3\n");
   auto format = ReadDataDirFormat(Env::Default(), dir.path());
   ASSERT_TRUE(format.ok()) << format.status();
   EXPECT_EQ(*format, kDataDirFormat);
@@ -59,25 +59,39 @@ TEST(DataDirFormatTest, AnUnmarkedDirectoryOfThisFormatIsMarkedAndServes) {
   ASSERT_TRUE(store.ok()) << store.status();
   EXPECT_TRUE((*store)->Map("alpha").ok());
   EXPECT_TRUE((*store)->FailedMaps().empty());
-  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/FORMAT"), "fremen data directory format 2\n");
+  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/FORMAT"), "fremen data directory format 3\n");
+}
+
+TEST(DataDirFormatTest, AFormat2DirectoryIsMarkedFormat3AndServes) {
+  TempDir dir;
+  TwoMaps(dir);
+  WriteText(dir.path() + "/FORMAT", "fremen data directory format 2\n");
+  EXPECT_TRUE(VerifyDataDir(dir.path(), {}).problems.empty());
+  auto store = Store::Open(dir.path(), {});
+  ASSERT_TRUE(store.ok()) << store.status();
+  EXPECT_TRUE((*store)->Map("alpha").ok());
+  EXPECT_TRUE((*store)->FailedMaps().empty());
+  // Marked before any map was opened: a format 2 fremend, which would not read the published
+  // models' database, refuses it from now on.
+  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/FORMAT"), "fremen data directory format 3\n");
 }
 
 TEST(DataDirFormatTest, ANewerFormatIsRefusedAndNothingIsOpened) {
   TempDir dir;
   TwoMaps(dir);
-  WriteText(dir.path() + "/FORMAT", "fremen data directory format 3\n");
+  WriteText(dir.path() + "/FORMAT", "fremen data directory format 4\n");
   const std::string catalog_before = testing::ReadWholeFile(dir.path() + "/catalog/data.mdb");
   auto store = Store::Open(dir.path(), {});
   ASSERT_TRUE(absl::IsFailedPrecondition(store.status())) << store.status();
-  EXPECT_TRUE(Contains(store.status(), "is data directory format 3, written by a newer fremend; this one reads format 2"))
+  EXPECT_TRUE(Contains(store.status(), "is data directory format 4, written by a newer fremend; this one reads formats 2 to 3"))
       << store.status();
   EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/catalog/data.mdb"), catalog_before);
-  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/FORMAT"), "fremen data directory format 3\n");
+  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/FORMAT"), "fremen data directory format 4\n");
   // The offline check says the same and reads no further.
   const DataDirVerifyReport report = VerifyDataDir(dir.path(), {});
   ASSERT_EQ(report.problems.size(), 1u);
   EXPECT_EQ(report.problems[0].file, "FORMAT");
-  EXPECT_NE(report.problems[0].what.find("format 3"), std::string::npos) << report.problems[0].what;
+  EXPECT_NE(report.problems[0].what.find("format 4"), std::string::npos) << report.problems[0].what;
   EXPECT_TRUE(report.maps.empty());
 }
 
@@ -105,7 +119,7 @@ TEST(DataDirFormatTest, AnUnmarkedDirectoryWithDamagedCatalogRecordsServesWithTh
   auto store = Store::Open(dir.path(), {});
   ASSERT_TRUE(store.ok()) << store.status();
   EXPECT_EQ((*store)->FailedMaps().size(), 2u);
-  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/FORMAT"), "fremen data directory format 2\n");
+  EXPECT_EQ(testing::ReadWholeFile(dir.path() + "/FORMAT"), "fremen data directory format 3\n");
 }
 
 }  // namespace

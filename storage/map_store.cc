@@ -72,7 +72,7 @@ std::shared_ptr<MapObserver> ObserverOf(const StoreOptions& options, const std::
 // The bytes of the records a checkpoint writes.
 uint64_t ImageBytes(const Shard::CheckpointImage& image) {
   uint64_t bytes = image.touched.size() + image.dedup.size();
-  for (const auto* records : {&image.dynamic, &image.lossless, &image.wide, &image.labels, &image.statics}) {
+  for (const auto* records : {&image.dynamic, &image.published, &image.lossless, &image.wide, &image.labels, &image.statics}) {
     for (const auto& [key, record] : *records) bytes += sizeof(key) + record.size();
   }
   return bytes;

@@ -59,6 +59,11 @@ namespace fs = std::filesystem;
 // The first byte of a log record (storage/map_store.cc).
 constexpr uint8_t kBatchRecord = 'B';
 constexpr uint8_t kPublishRecord = 'P';
+
+// A record that belongs to a dynamic state's record, as the salvage report names it.
+const char* AttachedRecordName(const std::string& db) {
+  return db == sr::kPublishedDb ? "a published model" : db == sr::kWideDb ? "a wide body" : "a lossless history";
+}
 // The log's record header (storage/wal/wal.h).
 constexpr uint64_t kLogRecordHeader = 16;
 // Records written to a new shard per LMDB transaction.
@@ -143,7 +148,7 @@ class ShardSalvager {
     // The meta records first: the checkpoint LSN decides what the log replays, and the touched
     // list is filtered by the states that survive.
     for (const std::string db :
-         {sr::kMetaDb, sr::kStaticDb, sr::kDynamicDb, sr::kLosslessDb, sr::kWideDb, sr::kLabelsDb}) {
+         {sr::kMetaDb, sr::kStaticDb, sr::kDynamicDb, sr::kPublishedDb, sr::kLosslessDb, sr::kWideDb, sr::kLabelsDb}) {
       ReadDatabase(from_dir, db);
       if (!write_error_.ok()) return write_error_;
       if (db == sr::kDynamicDb) WriteStatic();
@@ -306,12 +311,13 @@ class ShardSalvager {
     } else if (db == sr::kDynamicDb) {
       checked = checks_.Dynamic(k, value);
       if (checked.ok()) dynamic_keys_.insert(k);
-    } else if (db == sr::kLosslessDb || db == sr::kWideDb) {
+    } else if (db == sr::kPublishedDb || db == sr::kLosslessDb || db == sr::kWideDb) {
       if (!dynamic_keys_.contains(k)) {
-        checked = absl::DataLossError(db == sr::kWideDb ? "a wide body without its state (its record was lost)"
-                                                        : "a lossless history without its state (its record was lost)");
+        checked = absl::DataLossError(absl::StrCat(AttachedRecordName(db), " without its state (its record was lost)"));
       } else {
-        checked = db == sr::kWideDb ? checks_.Wide(value) : checks_.Lossless(value);
+        checked = db == sr::kPublishedDb ? checks_.Published(value)
+                  : db == sr::kWideDb    ? checks_.Wide(value)
+                                         : checks_.Lossless(value);
       }
     } else if (db == sr::kLabelsDb) {
       checked = checks_.Label(k, value);

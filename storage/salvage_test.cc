@@ -468,8 +468,8 @@ TEST(SalvageTest, ALostCheckpointLsnAppliesNoLogRecordToItsShardTwice) {
   EXPECT_EQ(report->log.records_kept, 10u);
   EXPECT_EQ(report->log.last_lsn, 34u);
   ASSERT_EQ(report->shards.size(), 2u);
-  EXPECT_EQ(report->shards[1].databases[5].name, "meta");
-  EXPECT_EQ(report->shards[1].databases[5].lost, 1u);
+  EXPECT_EQ(report->shards[1].databases[6].name, "meta");
+  EXPECT_EQ(report->shards[1].databases[6].lost, 1u);
   bool named = false;
   for (const VerifyProblem& p : report->lost) {
     named |= p.file == "shard-1/data.mdb" && p.where == "meta record checkpoint_lsn" &&

@@ -18,6 +18,7 @@ namespace {
 
 using shard_records::kDedupKey;
 using shard_records::kDynamicDb;
+using shard_records::kPublishedDb;
 using shard_records::kLabelsDb;
 using shard_records::kLosslessDb;
 using shard_records::kLsnKey;
@@ -124,10 +125,13 @@ uint32_t Shard::ReserveSlot(uint64_t key) {
 }
 
 void Shard::MarkDirty(uint32_t slot) {
-  if (!slots_[slot].dirty) {
-    slots_[slot].dirty = 1;
-    dirty_slots_.push_back(slot);
-  }
+  if (!slots_[slot].dirty) dirty_slots_.push_back(slot);
+  slots_[slot].dirty |= kDirtyAll;
+}
+
+void Shard::MarkPublishedDirty(uint32_t slot) {
+  if (!slots_[slot].dirty) dirty_slots_.push_back(slot);
+  slots_[slot].dirty |= kDirtyPublished;
 }
 
 uint32_t Shard::AddDynamic(uint32_t slot) {
@@ -170,15 +174,22 @@ void Shard::StoreModel(uint32_t d, const model::CompactStateModel& m) {
 }
 
 model::CompactStateModel Shard::ModelOf(uint32_t d) const {
+  model::CompactStateModel m = UnpublishedModelOf(d);
+  if (models_.published(d)) m.set_published(PublishedOf(d));
+  return m;
+}
+
+model::CompactStateModel Shard::UnpublishedModelOf(uint32_t d) const {
   model::CompactStateModel m(settings_);
   spectra_.Load(d, m.mutable_spectrum());
-  if (models_.published(d)) {
-    const model::CompactModelHeader& h = models_.header(d);
-    m.set_published(model::PublishedModel::Restore(h.alpha0, h.order, models_.Components(d)));
-  }
   m.mutable_persistence() = persistence_[d];
   m.mutable_order_errors() = errors_.Get(d);
   return m;
+}
+
+model::PublishedModel Shard::PublishedOf(uint32_t d) const {
+  const model::CompactModelHeader& h = models_.header(d);
+  return model::PublishedModel::Restore(h.alpha0, h.order, models_.Components(d));
 }
 
 void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::span<const float> values) {
@@ -212,7 +223,7 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
           break;
         }
         cell.observed = 1;
-        if (!cell.dirty) [[unlikely]] MarkDirty(scan_slots[i]);
+        if (!(cell.dirty & kDirtyAll)) [[unlikely]] MarkDirty(scan_slots[i]);
         state.span = static_cast<float>(t - state.t_first);
         state.count_value = count_value + 2;
       }
@@ -539,8 +550,9 @@ Shard::CheckpointImage Shard::PrepareCheckpoint(uint64_t lsn, const DedupTable& 
     std::vector<uint32_t> dirty = dirty_slots_;
     std::sort(dirty.begin(), dirty.end(),
               [&](uint32_t a, uint32_t b) ABSL_SHARED_LOCKS_REQUIRED(mutex_) { return slots_[a].key < slots_[b].key; });
-    std::vector<uint64_t> dirty_bricks;
+    std::vector<uint64_t> dirty_bricks;  // a published model alone changes no brick
     for (uint32_t slot : dirty) {
+      if (!(slots_[slot].dirty & kDirtyAll)) continue;
       const uint64_t brick = BrickOf(slots_[slot].key);
       if (dirty_bricks.empty() || dirty_bricks.back() != brick) dirty_bricks.push_back(brick);
     }
@@ -548,7 +560,11 @@ Shard::CheckpointImage Shard::PrepareCheckpoint(uint64_t lsn, const DedupTable& 
       const uint32_t d = slots_[slot].dynamic;
       if (d == kNone) continue;
       const uint64_t key = slots_[slot].key;
-      image.dynamic.emplace_back(key, model::EncodeStateModel(ModelOf(d)));
+      // A state is published from its first publication on, so a published record is never
+      // deleted: the one written last is the state's.
+      if (models_.published(d)) image.published.emplace_back(key, model::EncodePublishedModel(PublishedOf(d)));
+      if (!(slots_[slot].dirty & kDirtyAll)) continue;
+      image.dynamic.emplace_back(key, model::EncodeStateModel(UnpublishedModelOf(d)));
       if (lossless_) image.lossless.emplace_back(key, lossless_histories_[d].Encode());
       if (wide_.wide(d)) image.wide.emplace_back(key, wide_.Encode(d));
     }
@@ -587,11 +603,12 @@ absl::Status Shard::WriteCheckpoint(const CheckpointImage& image) {
   const absl::Status written = env_->Write([&](LmdbTxn& txn) -> absl::Status {
     auto static_db = txn.Db(kStaticDb);
     auto dynamic_db = txn.Db(kDynamicDb);
+    auto published_db = txn.Db(kPublishedDb);
     auto lossless_db = txn.Db(kLosslessDb);
     auto wide_db = txn.Db(kWideDb);
     auto labels_db = txn.Db(kLabelsDb);
     auto meta_db = txn.Db(kMetaDb);
-    for (auto* db : {&static_db, &dynamic_db, &lossless_db, &wide_db, &labels_db, &meta_db}) {
+    for (auto* db : {&static_db, &dynamic_db, &published_db, &lossless_db, &wide_db, &labels_db, &meta_db}) {
       if (!db->ok()) return db->status();
     }
     const auto put_all = [&](MDB_dbi db, const std::vector<std::pair<uint64_t, std::string>>& records) {
@@ -601,6 +618,7 @@ absl::Status Shard::WriteCheckpoint(const CheckpointImage& image) {
       return absl::OkStatus();
     };
     if (absl::Status s = put_all(*dynamic_db, image.dynamic); !s.ok()) return s;
+    if (absl::Status s = put_all(*published_db, image.published); !s.ok()) return s;
     if (absl::Status s = put_all(*lossless_db, image.lossless); !s.ok()) return s;
     if (absl::Status s = put_all(*wide_db, image.wide); !s.ok()) return s;
     for (const auto& [brick, value] : image.statics) {
@@ -686,6 +704,22 @@ absl::Status Shard::Load() {
           if (!decoded.ok()) return decoded.status();
           const uint32_t slot = FindOrAddSlot(key);
           StoreModel(slots_[slot].dynamic == kNone ? AddDynamic(slot) : slots_[slot].dynamic, *decoded);
+          return absl::OkStatus();
+        });
+        !s.ok()) {
+      return s;
+    }
+    // After the dynamic records: a published record replaces the model a dynamic record written
+    // before format 3 holds.
+    if (absl::Status s = scan(kPublishedDb, [&](uint64_t key, std::string_view value) ABSL_NO_THREAD_SAFETY_ANALYSIS
+                                  -> absl::Status {
+          const uint32_t slot = FindSlot(key);
+          if (slot == kNone || slots_[slot].dynamic == kNone) {
+            return absl::DataLossError("a published model without its state");
+          }
+          auto decoded = model::DecodePublishedModel(value, settings_.periods.size(), settings_.max_order);
+          if (!decoded.ok()) return decoded.status();
+          models_.Set(slots_[slot].dynamic, *decoded);
           return absl::OkStatus();
         });
         !s.ok()) {

@@ -112,7 +112,7 @@ class Shard {
   // write fails with its error: the failed image's states are clean in memory but not on disk.
   struct CheckpointImage {
     uint64_t lsn = 0;
-    std::vector<std::pair<uint64_t, std::string>> dynamic, lossless, wide, labels;  // state key → record
+    std::vector<std::pair<uint64_t, std::string>> dynamic, published, lossless, wide, labels;  // state key → record
     std::vector<std::pair<uint64_t, std::string>> statics;  // brick → StaticBrick, empty = delete it
     std::string touched, dedup;
   };
@@ -184,7 +184,11 @@ class Shard {
   // What every observation of a dynamic state updates besides its spectrum and order errors.
   void ObserveBesidesSpectrum(uint32_t d, double t, float value) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   uint32_t AddDynamic(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // The slot's records change: all of them are written by the next checkpoint.
   void MarkDirty(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // Only the slot's published model changes: the next checkpoint writes its published record
+  // alone, unless something else marks the slot dirty meanwhile.
+  void MarkPublishedDirty(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // p(t) of the state behind a handle (see kStaticHandle).
   float PredictHandle(uint32_t handle, const model::PhasorTable& table, const PredictOptions& options) const
       ABSL_SHARED_LOCKS_REQUIRED(mutex_);
@@ -199,6 +203,10 @@ class Shard {
   std::string EncodeTouched() const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   absl::Status DecodeTouched(std::string_view bytes) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   model::CompactStateModel ModelOf(uint32_t dynamic) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  // ModelOf without the published model: what the dynamic record holds (see kPublishedDb).
+  model::CompactStateModel UnpublishedModelOf(uint32_t dynamic) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  // The published model of a dynamic state that has one.
+  model::PublishedModel PublishedOf(uint32_t dynamic) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   void StoreModel(uint32_t dynamic, const model::CompactStateModel& model) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // Not analysed: Open calls it before the shard is shared, when there is nothing to lock against.
   absl::Status Load() ABSL_NO_THREAD_SAFETY_ANALYSIS;
@@ -225,10 +233,11 @@ class Shard {
     model::StaticState static_state;
     uint64_t key = 0;
     uint32_t dynamic = kNone;  // kNone while static
-    uint8_t dirty = 0;
+    uint8_t dirty = 0;         // kDirtyAll and kDirtyPublished bits: what the next checkpoint writes
     uint8_t observed = 0;      // a slot of an allocated run whose cell has not been seen is unused
   };
   static_assert(sizeof(Slot) == 32);
+  static constexpr uint8_t kDirtyAll = 1, kDirtyPublished = 2;
   std::vector<Slot> slots_ ABSL_GUARDED_BY(mutex_);
   std::vector<uint32_t> dirty_slots_;
   // Per dynamic state.

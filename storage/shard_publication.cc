@@ -26,7 +26,13 @@ void Shard::PublishState(uint32_t d, bool history_updated) {
   if (settings_.error_half_life == 0) errors_.Reset(d);  // "only since the last update"
   if (lossless_ && !history_updated) (void)lossless_histories_[d].Update(settings_.max_order);
   publish_flags_[d] = 0;
-  MarkDirty(slot_of_[d]);
+  // A publication changes the published model alone, unless it also resets the order errors or
+  // transforms a lossless history: then the state's other records change too.
+  if (settings_.error_half_life == 0 || lossless_) {
+    MarkDirty(slot_of_[d]);
+  } else {
+    MarkPublishedDirty(slot_of_[d]);
+  }
 }
 
 size_t Shard::BeginPublication() {

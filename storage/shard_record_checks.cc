@@ -52,6 +52,10 @@ absl::Status ShardRecordChecks::Lossless(std::string_view value) const {
   return model::LosslessHistory::Decode(value).status();
 }
 
+absl::Status ShardRecordChecks::Published(std::string_view value) const {
+  return model::DecodePublishedModel(value, settings_.periods.size(), settings_.max_order).status();
+}
+
 absl::Status ShardRecordChecks::Wide(std::string_view value) const {
   model::WideBodies bodies(settings_.periods.size());
   return bodies.Decode(0, value);

@@ -30,6 +30,7 @@ class ShardRecordChecks {
   absl::Status Dynamic(uint64_t key, std::string_view value) const;
   // Without its state: the caller's.
   absl::Status Lossless(std::string_view value) const;
+  absl::Status Published(std::string_view value) const;
   absl::Status Wide(std::string_view value) const;
   absl::Status Label(uint64_t key, std::string_view value) const;
 

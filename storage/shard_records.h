@@ -18,6 +18,11 @@ namespace fremen::storage::shard_records {
 
 inline constexpr char kStaticDb[] = "static";      // brick key → StaticBrick
 inline constexpr char kDynamicDb[] = "dynamic";    // state key → EncodeStateModel<float>
+// state key → EncodePublishedModel: a dynamic state's published model, kept apart from its
+// spectrum so that a checkpoint after the update job writes ~70 bytes a state, not ~560
+// (docs/storage.md, "Published models"). A dynamic record written before data directory format 3
+// holds its published model itself; a record here replaces it.
+inline constexpr char kPublishedDb[] = "published";
 inline constexpr char kLosslessDb[] = "lossless";  // state key → LosslessHistory
 inline constexpr char kWideDb[] = "wide";          // state key → double spectrum body (WideBodies)
 inline constexpr char kLabelsDb[] = "labels";      // state key → EncodeLabel
@@ -28,7 +33,8 @@ inline constexpr char kTouchedKey[] = "touched";
 
 // Every database of a shard, in the order the shard loads them.
 inline const std::vector<std::string>& AllDatabases() {
-  static const std::vector<std::string> all = {kStaticDb, kDynamicDb, kLosslessDb, kWideDb, kLabelsDb, kMetaDb};
+  static const std::vector<std::string> all = {kStaticDb,   kDynamicDb, kPublishedDb, kLosslessDb,
+                                                   kWideDb,     kLabelsDb,  kMetaDb};
   return all;
 }
 

@@ -34,7 +34,7 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& data_dir, 
   // Before anything is created or opened: a directory another version laid out is refused as it is.
   auto format = ReadDataDirFormat(options.env, data_dir);
   if (!format.ok()) return format.status();
-  if (*format != 0 && *format != kDataDirFormat) return UnreadableFormatError(data_dir, *format);
+  if (!ReadableDataDirFormat(*format)) return UnreadableFormatError(data_dir, *format);
   std::error_code error;
   fs::create_directories(data_dir + "/maps", error);
   if (error) return absl::InternalError(absl::StrCat("cannot create ", data_dir, "/maps: ", error.message()));
@@ -52,9 +52,10 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& data_dir, 
   std::vector<MapInfo> all;
   std::vector<DamagedCatalogEntry> damaged;
   if (absl::Status listed = store->ListCatalog(all, damaged); !listed.ok()) return listed;
-  // No FORMAT: a new directory, or one this format wrote before it kept the file (format 1's, with
+  // No FORMAT: a new directory, or one format 2 wrote before it kept the file (format 1's, with
   // no record checksums, stopped at Catalog::Open: LmdbEnv refuses records without checksums).
-  if (*format == 0) {
+  // Format 2 is marked 3 before a map is opened, whose next checkpoint may write a published record.
+  if (*format != kDataDirFormat) {
     if (absl::Status written = WriteDataDirFormat(options.env, data_dir); !written.ok()) return written;
   }
   base::MutexLock lock(&store->mutex_);

@@ -73,6 +73,7 @@ class ShardChecker {
     const absl::Status read = env.Read([&](LmdbTxn& txn) -> absl::Status {
       ScanDb(txn, sr::kStaticDb, [&](uint64_t brick, std::string_view value) { return CheckStatic(brick, value); });
       ScanDb(txn, sr::kDynamicDb, [&](uint64_t key, std::string_view value) { return CheckDynamic(key, value); });
+      ScanDb(txn, sr::kPublishedDb, [&](uint64_t key, std::string_view value) { return CheckPublished(key, value); });
       ScanDb(txn, sr::kLosslessDb, [&](uint64_t key, std::string_view value) { return CheckLossless(key, value); });
       ScanDb(txn, sr::kWideDb, [&](uint64_t key, std::string_view value) { return CheckWide(key, value); });
       ScanDb(txn, sr::kLabelsDb, [&](uint64_t key, std::string_view value) { return CheckLabel(key, value); });
@@ -143,6 +144,11 @@ class ShardChecker {
     if (info_.lossless_sampling_period <= 0) return absl::DataLossError("a lossless history in a map without them");
     if (!dynamic_keys_.contains(key)) return absl::DataLossError("a lossless history without its state");
     return checks_.Lossless(value);
+  }
+
+  absl::Status CheckPublished(uint64_t key, std::string_view value) {
+    if (!dynamic_keys_.contains(key)) return absl::DataLossError("a published model without its state");
+    return checks_.Published(value);
   }
 
   absl::Status CheckWide(uint64_t key, std::string_view value) {
@@ -525,7 +531,7 @@ DataDirVerifyReport VerifyDataDir(const std::string& data_dir, const VerifyOptio
   // No FORMAT file is no problem: the next store to open the directory writes it (data_dir_format.h).
   if (auto format = ReadDataDirFormat(Env::Default(), data_dir); !format.ok()) {
     report.problems.push_back({"FORMAT", "", std::string(format.status().message())});
-  } else if (*format != 0 && *format != kDataDirFormat) {
+  } else if (!ReadableDataDirFormat(*format)) {
     report.problems.push_back({"FORMAT", "", std::string(UnreadableFormatError(data_dir, *format).message())});
     return report;
   }
