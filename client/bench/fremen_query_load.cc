@@ -96,7 +96,7 @@ Options Parse(int argc, char** argv) {
     else if (key == "batch") o.batch = std::stoi(value);
     else if (key == "large-batch") o.large_batch = std::stoi(value);
     else if (key == "batched-only") o.batched_only = true;
-    else if (key == "windows") o.windows = std::stoi(value);
+    else if (key == "windows") o.windows = std::max(1, std::stoi(value));
     else if (key == "window-predictions") o.window_predictions = std::stod(value);
     else {
       std::fprintf(stderr, "unknown flag --%s\n%s", key.c_str(), kUsage);
