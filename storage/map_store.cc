@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <future>
+#include <type_traits>
 
 #include "absl/strings/cord.h"
 #include "absl/strings/numbers.h"
@@ -921,10 +922,33 @@ absl::Status MapStoreImpl::WriteCheckpoint(uint64_t lsn, std::vector<Shard::Chec
   return status;
 }
 
+namespace {
+
+// Appends each position i of `keys` to at[ShardOf(keys[i], shards)]. With the shard count a
+// std::integral_constant, for the usual power of two the hash's modulo is a mask, not a division per
+// key (which was most of this loop's cost for a batched Predict).
+template <typename ShardCount>
+void SplitPositions(std::span<const uint64_t> keys, ShardCount shards, std::vector<std::vector<uint32_t>>& at) {
+  for (size_t i = 0; i < keys.size(); ++i) at[ShardOf(keys[i], shards)].push_back(static_cast<uint32_t>(i));
+}
+
+template <uint32_t kShards>
+using Shards = std::integral_constant<uint32_t, kShards>;
+
+}  // namespace
+
 std::vector<std::vector<uint32_t>> MapStoreImpl::PositionsByShard(std::span<const uint64_t> keys) const {
-  std::vector<std::vector<uint32_t>> at(shards_.size());
-  for (auto& positions : at) positions.reserve(keys.size() / shards_.size() + 1);
-  for (size_t i = 0; i < keys.size(); ++i) at[ShardOf(keys[i], info_.shards)].push_back(static_cast<uint32_t>(i));
+  const uint32_t shards = info_.shards;
+  std::vector<std::vector<uint32_t>> at(shards);
+  // Bricks are spread evenly, but a small batch strays from the mean: room for 1/8 more.
+  for (auto& positions : at) positions.reserve(keys.size() / shards + keys.size() / (8 * shards) + 16);
+  switch (shards) {
+    case 1: SplitPositions(keys, Shards<1>{}, at); break;
+    case 2: SplitPositions(keys, Shards<2>{}, at); break;
+    case 4: SplitPositions(keys, Shards<4>{}, at); break;
+    case 8: SplitPositions(keys, Shards<8>{}, at); break;
+    default: SplitPositions(keys, shards, at);
+  }
   return at;
 }
 

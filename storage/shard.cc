@@ -49,7 +49,13 @@ Shard::Shard(const MapInfo& map, const model::ModelSettings& settings, std::uniq
       models_(settings.max_order),
       errors_(settings.max_order),
       publisher_(settings.periods, settings.max_order),
-      publish_scratch_(settings.periods.size()) {}
+      publish_scratch_(settings.periods.size()) {
+  if (map.kind == MapKind::kGrid && map.grid.size[0] > 0 && map.grid.size[1] > 0 && map.grid.size[2] > 0) {
+    // Morton keys grow with each index, so the last cell has the largest key.
+    const uint64_t last = BrickOf(grid_keys_.Key(map.grid.size[0] - 1, map.grid.size[1] - 1, map.grid.size[2] - 1));
+    if (last < kMaxDirectoryBricks) brick_directory_.assign(last + 1, kNone);
+  }
+}
 
 absl::StatusOr<std::unique_ptr<Shard>> Shard::Open(const MapInfo& map, const model::ModelSettings& settings,
                                                    const std::string& dir, const LmdbOptions& options,
@@ -80,6 +86,7 @@ Shard::Brick& Shard::BrickFor(uint64_t key) {
   if (brick != cached_brick_) {
     auto [it, inserted] = bricks_.try_emplace(brick, static_cast<uint32_t>(brick_data_.size()));
     if (inserted) {
+      if (brick < brick_directory_.size()) brick_directory_[brick] = it->second;
       brick_data_.emplace_back();
       brick_data_.back().handles.fill(kNone);
       brick_data_.back().chunk_base.fill(kNone);
@@ -370,12 +377,15 @@ void Shard::PredictKeys(std::span<const uint64_t> keys, std::span<const uint32_t
   for (size_t begin = 0; begin < at.size(); begin += kBatch) {
     const size_t count = std::min(at.size() - begin, kBatch);
     const uint32_t* positions = at.data() + begin;
-    for (size_t k = 0; k < count; ++k) bricks_.prefetch(BrickOf(keys[positions[k]]));
-    BrickLookup lookup;
+    if (brick_directory_.empty()) {
+      for (size_t k = 0; k < count; ++k) bricks_.prefetch(BrickOf(keys[positions[k]]));
+      BrickLookup lookup;
+      for (size_t k = 0; k < count; ++k) bricks[k] = lookup(bricks_, BrickOf(keys[positions[k]]));
+    } else {
+      for (size_t k = 0; k < count; ++k) bricks[k] = DirectoryLookup(BrickOf(keys[positions[k]]));
+    }
     for (size_t k = 0; k < count; ++k) {
-      const uint64_t key = keys[positions[k]];
-      bricks[k] = lookup(bricks_, BrickOf(key));
-      if (bricks[k] >= 0) __builtin_prefetch(&brick_data_[bricks[k]].handles[key & 511]);
+      if (bricks[k] >= 0) __builtin_prefetch(&brick_data_[bricks[k]].handles[keys[positions[k]] & 511]);
     }
     for (size_t k = 0; k < count; ++k) {
       handles[k] = bricks[k] < 0 ? kNone : brick_data_[bricks[k]].handles[keys[positions[k]] & 511];

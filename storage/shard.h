@@ -225,6 +225,17 @@ class Shard {
 
   absl::flat_hash_map<uint64_t, uint32_t> bricks_ ABSL_GUARDED_BY(mutex_);  // brick → index into bricks_data_
   std::vector<Brick> brick_data_ ABSL_GUARDED_BY(mutex_);
+  // The same as bricks_ as an array, brick → index or kNone, for a grid whose keys span at most
+  // kMaxDirectoryBricks bricks (a 2-D grid up to 16k × 16k cells; empty otherwise): a batched
+  // Predict's scattered cells are looked up without a hash and a probe each (docs/performance.md,
+  // "Batched Predict"). Kept by BrickFor with bricks_.
+  static constexpr uint64_t kMaxDirectoryBricks = uint64_t{1} << 20;
+  std::vector<uint32_t> brick_directory_ ABSL_GUARDED_BY(mutex_);
+  // The index of `brick` in brick_data_, or -1: from the directory when there is one.
+  int64_t DirectoryLookup(uint64_t brick) const ABSL_SHARED_LOCKS_REQUIRED(mutex_) {
+    const uint32_t index = brick < brick_directory_.size() ? brick_directory_[brick] : kNone;
+    return index == kNone ? -1 : static_cast<int64_t>(index);
+  }
   uint64_t cached_brick_ = UINT64_MAX;  // BrickFor's last brick and its index
   uint32_t cached_brick_index_ = 0;
   // Per slot.

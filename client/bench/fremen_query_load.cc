@@ -55,13 +55,19 @@ struct Options {
   int region_reps = 15;
   int predict_calls = 20000;
   int concurrency = 8;
-  int batch = 1000;  // states per call of the batched Predict
+  int batch = 1000;          // states per call of the batched Predict
+  int large_batch = 10000;   // and a larger batch
+  int windows = 5;           // windows per batched figure (their median is printed)
+  double window_predictions = 2e6;  // predictions per window of the batched Predict
+  bool batched_only = false;  // only the batched Predict and its ceilings (for profiling the daemon)
 };
 
 const char kUsage[] =
     "usage: fremen_query_load [--address=HOST:PORT] [--map=NAME] [--token=TOKEN] [--create]\n"
     "                         [--size=CELLS] [--scans=N] [--scan-interval=S] [--region-reps=N]\n"
-    "                         [--predict-calls=N] [--concurrency=N] [--batch=STATES]\n";
+    "                         [--predict-calls=N] [--concurrency=N] [--batch=STATES]\n"
+    "                         [--large-batch=STATES] [--windows=N] [--window-predictions=N]\n"
+    "                         [--batched-only]\n";
 
 Options Parse(int argc, char** argv) {
   Options o;
@@ -88,6 +94,10 @@ Options Parse(int argc, char** argv) {
     else if (key == "predict-calls") o.predict_calls = std::stoi(value);
     else if (key == "concurrency") o.concurrency = std::stoi(value);
     else if (key == "batch") o.batch = std::stoi(value);
+    else if (key == "large-batch") o.large_batch = std::stoi(value);
+    else if (key == "batched-only") o.batched_only = true;
+    else if (key == "windows") o.windows = std::max(1, std::stoi(value));
+    else if (key == "window-predictions") o.window_predictions = std::stod(value);
     else {
       std::fprintf(stderr, "unknown flag --%s\n%s", key.c_str(), kUsage);
       std::exit(2);
@@ -115,8 +125,21 @@ class Bench {
   bool CreateAndFill();
   void Region(v1::RegionOutput output, const char* name);
   void Predict();
+  // The rate of predictions when calls ask for many states: `windows` windows each of --batch and
+  // --large-batch states a call, with 1 and with --concurrency calls in flight, beside two ceilings
+  // of the same run.
+  void BatchedPredict();
 
  private:
+  struct BatchFigures {
+    double rate = 0;     // median over the windows: states (predictions) per second
+    double latency = 0;  // median seconds a call
+  };
+  // `states` states a call (random cells, the requests made before the clock starts), `concurrency`
+  // threads calling on the one channel, `calls` calls each a window; false on an error.
+  bool Batched(int states, int concurrency, int calls, BatchFigures& figures);
+  std::vector<v1::PredictRequest> MakeRequests(int count, int states, uint64_t seed) const;
+
   static grpc::ChannelArguments ChannelArgs() {
     grpc::ChannelArguments args;
     args.SetMaxReceiveMessageSize(64 << 20);
@@ -307,6 +330,114 @@ std::vector<double> Bench::PredictLoop(int calls, int states, uint64_t seed, boo
   return latencies;
 }
 
+std::vector<v1::PredictRequest> Bench::MakeRequests(int count, int states, uint64_t seed) const {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<uint32_t> cell(0, o_.size - 1);
+  std::vector<v1::PredictRequest> requests(count);
+  for (v1::PredictRequest& request : requests) {
+    request.set_map(o_.map);
+    request.add_times(kT0 + o_.scan_interval * o_.scans + 3600);
+    v1::CellIndices& cells = *request.mutable_states()->mutable_cells();
+    for (int j = 0; j < states; ++j) {
+      cells.add_x(cell(rng));
+      cells.add_y(cell(rng));
+    }
+  }
+  return requests;
+}
+
+bool Bench::Batched(int states, int concurrency, int calls, BatchFigures& figures) {
+  // A few distinct requests a thread, so that no cache holds one call's states for the next.
+  constexpr int kRequestsPerThread = 4;
+  std::vector<std::vector<v1::PredictRequest>> requests(concurrency);
+  for (int t = 0; t < concurrency; ++t) requests[t] = MakeRequests(kRequestsPerThread, states, 1000 + t);
+  std::atomic<bool> ok{true};
+  std::vector<double> rates, latencies;
+  for (int window = 0; window <= o_.windows; ++window) {  // window 0 warms up
+    std::vector<std::vector<double>> per_thread(concurrency);
+    std::vector<std::thread> threads;
+    const auto start = Clock::now();
+    for (int t = 0; t < concurrency; ++t) {
+      threads.emplace_back([&, t] {
+        v1::PredictResponse response;
+        for (int i = 0; i < calls && ok; ++i) {
+          grpc::ClientContext context;
+          Prepare(context);
+          response.Clear();
+          const auto call_start = Clock::now();
+          const grpc::Status status = query_->Predict(&context, requests[t][i % kRequestsPerThread], &response);
+          per_thread[t].push_back(Seconds(Clock::now() - call_start));
+          if (!status.ok() || response.probabilities_size() != states) {
+            std::fprintf(stderr, "Predict: %s\n", status.error_message().c_str());
+            ok = false;
+          }
+        }
+      });
+    }
+    for (std::thread& thread : threads) thread.join();
+    const double elapsed = Seconds(Clock::now() - start);
+    if (!ok) return false;
+    if (window == 0) continue;
+    rates.push_back(static_cast<double>(states) * calls * concurrency / elapsed);
+    for (const auto& v : per_thread) latencies.insert(latencies.end(), v.begin(), v.end());
+  }
+  figures.rate = Median(rates);
+  figures.latency = Median(latencies);
+  return true;
+}
+
+// The client's own share of a batched call on one core: encoding the request and decoding a
+// response of `states` probabilities (what gRPC's codec does for it). The client and the daemon
+// share the machine, so this bounds what is left for the daemon.
+double ClientCodecRate(const v1::PredictRequest& request) {
+  v1::PredictResponse response;
+  const int states = request.states().cells().x_size();
+  for (int j = 0; j < states; ++j) response.add_probabilities(static_cast<float>(j) / static_cast<float>(states));
+  response.set_state_count(static_cast<uint32_t>(states));
+  response.set_time_count(1);
+  const std::string response_bytes = response.SerializeAsString();
+  std::string request_bytes;
+  v1::PredictResponse parsed;
+  std::vector<double> rates;
+  const int reps = std::max(1, 2'000'000 / std::max(states, 1));
+  for (int window = 0; window < 5; ++window) {
+    const auto start = Clock::now();
+    for (int i = 0; i < reps; ++i) {
+      request_bytes.clear();
+      request.SerializeToString(&request_bytes);
+      parsed.ParseFromString(response_bytes);
+    }
+    rates.push_back(static_cast<double>(states) * reps / Seconds(Clock::now() - start));
+  }
+  return Median(rates);
+}
+
+void Bench::BatchedPredict() {
+  const int concurrencies[2] = {1, std::max(1, o_.concurrency)};
+  for (const int states : {o_.batch, o_.large_batch}) {
+    for (const int concurrency : concurrencies) {
+      BatchFigures f;
+      const double calls = o_.window_predictions / (static_cast<double>(states) * concurrency);
+      if (!Batched(states, concurrency, std::max(1, static_cast<int>(calls)), f)) return;
+      std::printf("Predict %d states a call, %d in flight: median of %d windows %.2fM predictions/s, p50 %.0f µs a call\n",
+                  states, concurrency, o_.windows, f.rate / 1e6, f.latency * 1e6);
+    }
+  }
+  // Ceilings of the same run: the calls a second when a call asks for one state (what the call
+  // itself costs, gRPC and the daemon's per-call work), and the client's codec.
+  for (const int concurrency : concurrencies) {
+    BatchFigures f;
+    if (!Batched(1, concurrency, std::max(1, o_.predict_calls / o_.windows / concurrency), f)) return;
+    std::printf("ceiling: 1-state Predict calls, %d in flight: %.0f calls/s = %.1fM / %.1fM predictions/s at %d / %d "
+                "states a call\n",
+                concurrency, f.rate, f.rate * o_.batch / 1e6, f.rate * o_.large_batch / 1e6, o_.batch, o_.large_batch);
+  }
+  for (const int states : {o_.batch, o_.large_batch}) {
+    std::printf("ceiling: client encode + decode of %d states a call, one core: %.1fM predictions/s\n", states,
+                ClientCodecRate(MakeRequests(1, states, 7)[0]) / 1e6);
+  }
+}
+
 void Bench::Predict() {
   bool ok = true;
   PredictLoop(std::max(1, o_.predict_calls / 10), 1, 1, &ok);  // warm up the connection and caches
@@ -340,14 +471,6 @@ void Bench::Predict() {
   std::printf("Predict 1 state, %d in flight: p50 %.0f µs, p99 %.0f µs, %.0f predictions/s\n", o_.concurrency,
               Quantile(all, 0.5) * 1e6, Quantile(all, 0.99) * 1e6, all.size() / concurrent_elapsed);
 
-  const int batch_calls = std::max(1, o_.predict_calls / 20);
-  const auto batch_start = Clock::now();
-  std::vector<double> batches = PredictLoop(batch_calls, o_.batch, 3, &ok);
-  const double batch_elapsed = Seconds(Clock::now() - batch_start);
-  if (!ok) return;
-  std::sort(batches.begin(), batches.end());
-  std::printf("Predict %d states a call, 1 in flight: p50 %.0f µs a call, %.0f predictions/s\n", o_.batch,
-              Quantile(batches, 0.5) * 1e6, static_cast<double>(o_.batch) * batches.size() / batch_elapsed);
 }
 
 }  // namespace
@@ -356,8 +479,11 @@ int main(int argc, char** argv) {
   const Options options = Parse(argc, argv);
   Bench bench(options);
   if (options.create && !bench.CreateAndFill()) return 1;
-  bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT");
-  bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8");
-  bench.Predict();
+  if (!options.batched_only) {
+    bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT");
+    bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8");
+    bench.Predict();
+  }
+  bench.BatchedPredict();
   return 0;
 }

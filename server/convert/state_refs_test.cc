@@ -63,6 +63,51 @@ TEST(StateRefsTest, CellsOutsideTheGridAreOutOfRange) {
   EXPECT_EQ(ErrorOf(Grid(), refs).code(), absl::StatusCode::kOutOfRange);
 }
 
+// A batch of cells takes a path of its own (one check of the whole list, then the keys): every key
+// must be the one cell's Key, in a 2-D grid with z left out or given, and in a 3-D grid.
+TEST(StateRefsTest, ManyCellsGetTheirOwnKeys) {
+  for (const uint32_t size_z : {1u, 5u}) {
+    for (const bool with_z : {false, true}) {
+      storage::MapInfo map = Grid();
+      map.grid.size[2] = size_z;
+      v1::StateRefs refs;
+      std::vector<uint64_t> expected;
+      for (uint32_t i = 0; i < 1000; ++i) {
+        const uint32_t x = (i * 7) % 40, y = (i * 13) % 30, z = with_z ? (i * 3) % size_z : 0;
+        refs.mutable_cells()->add_x(x);
+        refs.mutable_cells()->add_y(y);
+        if (with_z) refs.mutable_cells()->add_z(z);
+        expected.push_back(map.grid.keys().Key(x, y, z));
+      }
+      auto keys = KeysOfRefs(map, refs, "states");
+      ASSERT_TRUE(keys.ok()) << keys.status();
+      EXPECT_EQ(*keys, expected) << "size_z " << size_z << (with_z ? ", z given" : ", z left out");
+    }
+  }
+}
+
+// In a long list, the error names the first cell outside, whichever axis it is outside on.
+TEST(StateRefsTest, TheFirstCellOutsideALongListIsNamed) {
+  storage::MapInfo map = Grid();
+  map.grid.size[2] = 4;
+  for (const int axis : {0, 1, 2}) {
+    v1::StateRefs refs;
+    for (uint32_t i = 0; i < 1000; ++i) {
+      refs.mutable_cells()->add_x(i % 40);
+      refs.mutable_cells()->add_y(i % 30);
+      refs.mutable_cells()->add_z(i % 4);
+    }
+    const std::array<uint32_t, 3> outside = {40, 30, 4};
+    for (const int at : {617, 900}) {
+      v1::CellIndices& cells = *refs.mutable_cells();
+      (axis == 0 ? cells.mutable_x() : axis == 1 ? cells.mutable_y() : cells.mutable_z())->Set(at, outside[axis]);
+    }
+    const absl::Status s = ErrorOf(map, refs);
+    EXPECT_EQ(s.code(), absl::StatusCode::kOutOfRange) << "axis " << axis;
+    EXPECT_THAT(s.message(), HasSubstr("states.cells[617] = ")) << "axis " << axis;
+  }
+}
+
 TEST(StateRefsTest, MismatchedLengthsNameTheArray) {
   v1::StateRefs refs;
   refs.mutable_cells()->add_x(1);
