@@ -959,8 +959,7 @@ std::vector<float> MapStoreImpl::PredictWithObserved(std::span<const uint64_t> k
   return PredictKeys(keys, times, options, observed.data());
 }
 
-absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
-                                  std::vector<float>& out) const {
+absl::Status MapStoreImpl::CheckBox(const CellBox& box) const {
   if (info_.kind != MapKind::kGrid) {
     return absl::FailedPreconditionError(absl::StrCat("map ", info_.name, " is not a grid: it has no boxes"));
   }
@@ -971,12 +970,55 @@ absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const Predic
                                                 ", got [", box.lo[a], ", ", box.hi[a], ")"));
     }
   }
+  return absl::OkStatus();
+}
+
+absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
+                                  std::vector<float>& out) const {
+  if (absl::Status s = CheckBox(box); !s.ok()) return s;
   const model::PhasorTable table(settings_->periods, t);
   out.assign(box.cell_count(), kUnobservedProbability);
   ParallelForShards(
       shards_.size(), [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); },
       /*parallel=*/box.cell_count() >= (1u << 16));
   return absl::OkStatus();
+}
+
+absl::StatusOr<BoxSeries> MapStoreImpl::PlanBoxSeries(const CellBox& box, double t,
+                                                      const PredictOptions& options) const {
+  if (absl::Status s = CheckBox(box); !s.ok()) return s;
+  const model::PhasorTable table(settings_->periods, t);
+  BoxSeries plan;
+  plan.box = box;
+  plan.options = options;
+  plan.constant.assign(box.cell_count(), kUnobservedProbability);
+  std::vector<uint8_t> varying(box.cell_count(), 0);
+  ParallelForShards(
+      shards_.size(),
+      [&](size_t s) { shards_[s]->PredictBoxConstant(box, table, options, plan.constant.data(), varying.data()); },
+      /*parallel=*/box.cell_count() >= (1u << 16));
+  const GridKeys keys = info_.grid.keys();
+  const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
+  for (uint64_t i = 0; i < varying.size(); ++i) {
+    if (!varying[i]) continue;
+    plan.varying.push_back(static_cast<uint32_t>(i));
+    plan.varying_keys.push_back(keys.Key(static_cast<uint32_t>(box.lo[0] + i % nx),
+                                         static_cast<uint32_t>(box.lo[1] + i / nx % ny),
+                                         static_cast<uint32_t>(box.lo[2] + i / (nx * ny))));
+  }
+  plan.varying_by_shard = PositionsByShard(plan.varying_keys);
+  return plan;
+}
+
+void MapStoreImpl::PredictBoxSeries(const BoxSeries& plan, double t, std::vector<float>& out) const {
+  out.resize(plan.varying_keys.size());
+  const model::PhasorTable table(settings_->periods, t);
+  ParallelForShards(
+      shards_.size(),
+      [&](size_t s) {
+        shards_[s]->PredictKeys(plan.varying_keys, plan.varying_by_shard[s], table, plan.options, out.data());
+      },
+      /*parallel=*/out.size() >= kParallelPredictions);
 }
 
 std::optional<StateSnapshot> MapStoreImpl::Snapshot(uint64_t key) const { return ShardFor(key).Snapshot(key); }

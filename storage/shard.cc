@@ -395,10 +395,8 @@ void Shard::ObservedKeys(std::span<const uint64_t> keys, std::span<const uint32_
   }
 }
 
-void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                       float* out) const {
-  if (box.cell_count() == 0) return;
-  base::ReaderMutexLock lock(&mutex_);
+template <typename Visit, typename EndBrick>
+void Shard::ForEachBoxCell(const CellBox& box, Visit visit, EndBrick end_brick) const {
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
   const std::array<uint32_t, 3> bs = grid_keys_.brick_size();
   // A cell's index in its brick is its key's low 9 bits: the sum of each axis' bits, spread —
@@ -410,12 +408,7 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
     if (i < bs[1]) spread_y[i] = grid_keys_.LocalIndex(0, i, 0);
     if (i < bs[2]) spread_z[i] = grid_keys_.LocalIndex(0, 0, i);
   }
-  // Brick by brick: one hash lookup per brick, then the cells of the box inside it. The cells whose
-  // state has a published model — nearly all, on a map in use — go through the region kernel
-  // together, a brick at a time; the others are answered one by one.
-  std::array<uint32_t, 512> published;
-  std::array<float*, 512> published_cells;
-  std::array<float, 512> predicted;
+  // Brick by brick: one hash lookup per brick, then the cells of the box inside it.
   for (uint32_t bz = box.lo[2] / bs[2]; bz <= (box.hi[2] - 1) / bs[2]; ++bz) {
     for (uint32_t by = box.lo[1] / bs[1]; by <= (box.hi[1] - 1) / bs[1]; ++by) {
       for (uint32_t bx = box.lo[0] / bs[0]; bx <= (box.hi[0] - 1) / bs[0]; ++bx) {
@@ -425,28 +418,68 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
         const uint32_t z0 = std::max(box.lo[2], bz * bs[2]), z1 = std::min(box.hi[2], (bz + 1) * bs[2]);
         const uint32_t y0 = std::max(box.lo[1], by * bs[1]), y1 = std::min(box.hi[1], (by + 1) * bs[1]);
         const uint32_t x0 = std::max(box.lo[0], bx * bs[0]), x1 = std::min(box.hi[0], (bx + 1) * bs[0]);
-        size_t n = 0;
         for (uint32_t z = z0; z < z1; ++z) {
           for (uint32_t y = y0; y < y1; ++y) {
-            float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
+            // The index of cell (0, y, z) in the box (x = lo.x is at row + lo.x).
+            const uint64_t row = ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
             const uint32_t yz = spread_y[y & (bs[1] - 1)] | spread_z[z & (bs[2] - 1)];
             for (uint32_t x = x0; x < x1; ++x) {
               const uint32_t handle = brick.handles[yz | spread_x[x & mask_x]];
-              if (handle == kNone) continue;
-              if (!(handle & kStaticHandle) && models_.published(handle)) {
-                published[n] = handle;
-                published_cells[n++] = &row[x];
-              } else {
-                row[x] = PredictHandle(handle, table, options);
-              }
+              if (handle != kNone) visit(handle, row + x);
             }
           }
         }
-        PredictPublished({published.data(), n}, table, options, predicted.data());
-        for (size_t i = 0; i < n; ++i) *published_cells[i] = predicted[i];
+        end_brick();
       }
     }
   }
+}
+
+bool Shard::VariesWithTime(uint32_t handle, const PredictOptions& options) const {
+  if (handle == kNone || (handle & kStaticHandle)) return false;
+  if (options.persistence && settings_.persistence) return true;
+  if (!models_.published(handle)) return false;
+  const int order = options.order < 0 ? models_.header(handle).order : std::min(options.order, models_.max_order());
+  return order > 0;
+}
+
+void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
+                       float* out) const {
+  PredictBoxCells(box, table, options, out, /*varying=*/nullptr);
+}
+
+void Shard::PredictBoxConstant(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
+                               float* out, uint8_t* varying) const {
+  PredictBoxCells(box, table, options, out, varying);
+}
+
+void Shard::PredictBoxCells(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
+                            float* out, uint8_t* varying) const {
+  if (box.cell_count() == 0) return;
+  base::ReaderMutexLock lock(&mutex_);
+  // The cells whose state has a published model — nearly all, on a map in use — go through the
+  // region kernel together, a brick at a time; the others are answered one by one.
+  std::array<uint32_t, 512> published;
+  std::array<uint64_t, 512> published_cells;
+  std::array<float, 512> predicted;
+  size_t n = 0;
+  ForEachBoxCell(
+      box,
+      [&](uint32_t handle, uint64_t i) ABSL_NO_THREAD_SAFETY_ANALYSIS {  // under the lock above
+        if (varying != nullptr && VariesWithTime(handle, options)) {
+          varying[i] = 1;
+        } else if (!(handle & kStaticHandle) && models_.published(handle)) {
+          published[n] = handle;
+          published_cells[n++] = i;
+        } else {
+          out[i] = PredictHandle(handle, table, options);
+        }
+      },
+      [&]() ABSL_NO_THREAD_SAFETY_ANALYSIS {
+        PredictPublished({published.data(), n}, table, options, predicted.data());
+        for (size_t j = 0; j < n; ++j) out[published_cells[j]] = predicted[j];
+        n = 0;
+      });
 }
 
 bool Shard::Observed(uint64_t key) const {
