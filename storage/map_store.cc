@@ -992,21 +992,37 @@ absl::StatusOr<BoxSeries> MapStoreImpl::PlanBoxSeries(const CellBox& box, double
   plan.box = box;
   plan.options = options;
   plan.constant.assign(box.cell_count(), kUnobservedProbability);
-  std::vector<uint8_t> varying(box.cell_count(), 0);
+  constexpr uint32_t kConstant = UINT32_MAX;
+  std::vector<uint32_t> dynamic(box.cell_count(), kConstant);
   ParallelForShards(
       shards_.size(),
-      [&](size_t s) { shards_[s]->PredictBoxConstant(box, table, options, plan.constant.data(), varying.data()); },
+      [&](size_t s) { shards_[s]->PredictBoxConstant(box, table, options, plan.constant.data(), dynamic.data()); },
       /*parallel=*/box.cell_count() >= (1u << 16));
   const GridKeys keys = info_.grid.keys();
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
-  for (uint64_t i = 0; i < varying.size(); ++i) {
-    if (!varying[i]) continue;
+  plan.shards.resize(shards_.size());
+  for (uint64_t i = 0; i < dynamic.size(); ++i) {
+    if (dynamic[i] == kConstant) continue;
+    const uint64_t key = keys.Key(static_cast<uint32_t>(box.lo[0] + i % nx), static_cast<uint32_t>(box.lo[1] + i / nx % ny),
+                                  static_cast<uint32_t>(box.lo[2] + i / (nx * ny)));
+    BoxSeries::ShardPart& part = plan.shards[ShardOf(key, info_.shards)];
+    part.dynamic.push_back(dynamic[i]);
+    part.at.push_back(static_cast<uint32_t>(plan.varying.size()));
     plan.varying.push_back(static_cast<uint32_t>(i));
-    plan.varying_keys.push_back(keys.Key(static_cast<uint32_t>(box.lo[0] + i % nx),
-                                         static_cast<uint32_t>(box.lo[1] + i / nx % ny),
-                                         static_cast<uint32_t>(box.lo[2] + i / (nx * ny))));
+    plan.varying_keys.push_back(key);
   }
-  plan.varying_by_shard = PositionsByShard(plan.varying_keys);
+  // In record order within each shard, so that the kernel reads the models front to back.
+  for (BoxSeries::ShardPart& part : plan.shards) {
+    std::vector<uint32_t> order(part.dynamic.size());
+    for (uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return part.dynamic[a] < part.dynamic[b]; });
+    BoxSeries::ShardPart sorted;
+    for (const uint32_t k : order) {
+      sorted.dynamic.push_back(part.dynamic[k]);
+      sorted.at.push_back(part.at[k]);
+    }
+    part = std::move(sorted);
+  }
   return plan;
 }
 
@@ -1015,9 +1031,7 @@ void MapStoreImpl::PredictBoxSeries(const BoxSeries& plan, double t, std::vector
   const model::PhasorTable table(settings_->periods, t);
   ParallelForShards(
       shards_.size(),
-      [&](size_t s) {
-        shards_[s]->PredictKeys(plan.varying_keys, plan.varying_by_shard[s], table, plan.options, out.data());
-      },
+      [&](size_t s) { shards_[s]->PredictDynamic(plan.shards[s].dynamic, plan.shards[s].at, table, plan.options, out.data()); },
       /*parallel=*/out.size() >= kParallelPredictions);
 }
 

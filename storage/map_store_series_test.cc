@@ -79,7 +79,9 @@ class MapStoreSeriesTest : public ::testing::Test {
     // The first publication is at order 0 (no order scored yet); the second picks orders.
     for (uint64_t i = 0; i < 200; ++i) {
       ASSERT_TRUE(store_->Write(SweepScan(map, 1, i, cells_per_scan)).ok());
-      if (i % 100 == 99) ASSERT_TRUE(store_->PublishModels().ok());
+      if (i % 100 == 99) {
+        ASSERT_TRUE(store_->PublishModels().ok());
+      }
     }
     for (uint64_t i = 200; i < 230; ++i) ASSERT_TRUE(store_->Write(SweepScan(map, 1, i, cells_per_scan)).ok());
   }

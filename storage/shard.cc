@@ -349,9 +349,6 @@ void Shard::PredictKeys(std::span<const uint64_t> keys, std::span<const uint32_t
   constexpr size_t kBatch = 512;
   std::array<int64_t, kBatch> bricks;
   std::array<uint32_t, kBatch> handles;
-  std::array<uint32_t, kBatch> published;
-  std::array<uint32_t, kBatch> published_at;
-  std::array<float, kBatch> predicted;
   // kBatch positions at a time, in passes that each prefetch what the next one reads: a batch of
   // scattered states (a dashboard's, a fleet's) misses the cache three times per state — the brick
   // table, the brick's handles, the model record — and the passes overlap those misses instead of
@@ -370,19 +367,10 @@ void Shard::PredictKeys(std::span<const uint64_t> keys, std::span<const uint32_t
       handles[k] = bricks[k] < 0 ? kNone : brick_data_[bricks[k]].handles[keys[positions[k]] & 511];
       if (handles[k] != kNone && !(handles[k] & kStaticHandle)) model::PrefetchForRead(models_.record(handles[k]), 64);
     }
-    size_t n = 0;
-    for (size_t k = 0; k < count; ++k) {
-      const uint32_t i = positions[k], handle = handles[k];
-      if (observed) observed[i] = handle != kNone;
-      if (handle != kNone && !(handle & kStaticHandle) && models_.published(handle)) {
-        published[n] = handle;
-        published_at[n++] = i;
-      } else {
-        out[i] = PredictHandle(handle, table, options);
-      }
+    if (observed) {
+      for (size_t k = 0; k < count; ++k) observed[positions[k]] = handles[k] != kNone;
     }
-    PredictPublished({published.data(), n}, table, options, predicted.data());
-    for (size_t j = 0; j < n; ++j) out[published_at[j]] = predicted[j];
+    PredictHandles({handles.data(), count}, positions, table, options, out);
   }
 }
 
@@ -449,12 +437,41 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
 }
 
 void Shard::PredictBoxConstant(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                               float* out, uint8_t* varying) const {
-  PredictBoxCells(box, table, options, out, varying);
+                               float* out, uint32_t* dynamic) const {
+  PredictBoxCells(box, table, options, out, dynamic);
+}
+
+void Shard::PredictDynamic(std::span<const uint32_t> dynamic, std::span<const uint32_t> at,
+                           const model::PhasorTable& table, const PredictOptions& options, float* out) const {
+  base::ReaderMutexLock lock(&mutex_);
+  constexpr size_t kBatch = 512;
+  for (size_t begin = 0; begin < dynamic.size(); begin += kBatch) {
+    const size_t count = std::min(dynamic.size() - begin, kBatch);
+    PredictHandles(dynamic.subspan(begin, count), at.data() + begin, table, options, out);
+  }
+}
+
+void Shard::PredictHandles(std::span<const uint32_t> handles, const uint32_t* at, const model::PhasorTable& table,
+                           const PredictOptions& options, float* out) const {
+  std::array<uint32_t, 512> published;
+  std::array<uint32_t, 512> published_at;
+  std::array<float, 512> predicted;
+  size_t n = 0;
+  for (size_t k = 0; k < handles.size(); ++k) {
+    const uint32_t handle = handles[k];
+    if (handle != kNone && !(handle & kStaticHandle) && models_.published(handle)) {
+      published[n] = handle;
+      published_at[n++] = at[k];
+    } else {
+      out[at[k]] = PredictHandle(handle, table, options);
+    }
+  }
+  PredictPublished({published.data(), n}, table, options, predicted.data());
+  for (size_t j = 0; j < n; ++j) out[published_at[j]] = predicted[j];
 }
 
 void Shard::PredictBoxCells(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                            float* out, uint8_t* varying) const {
+                            float* out, uint32_t* dynamic) const {
   if (box.cell_count() == 0) return;
   base::ReaderMutexLock lock(&mutex_);
   // The cells whose state has a published model — nearly all, on a map in use — go through the
@@ -466,8 +483,8 @@ void Shard::PredictBoxCells(const CellBox& box, const model::PhasorTable& table,
   ForEachBoxCell(
       box,
       [&](uint32_t handle, uint64_t i) ABSL_NO_THREAD_SAFETY_ANALYSIS {  // under the lock above
-        if (varying != nullptr && VariesWithTime(handle, options)) {
-          varying[i] = 1;
+        if (dynamic != nullptr && VariesWithTime(handle, options)) {
+          dynamic[i] = handle;
         } else if (!(handle & kStaticHandle) && models_.published(handle)) {
           published[n] = handle;
           published_cells[n++] = i;

@@ -130,10 +130,15 @@ class Shard {
                   float* out) const;
   // PredictBox's first half for a box at many times: of the cells of `box` held by this shard,
   // those whose p(t) cannot change with t under `options` (VariesWithTime) get p(t) written into
-  // out[index in the box], exactly as PredictBox writes it; the others get varying[index] = 1
-  // (and out left as it is).
+  // out[index in the box], exactly as PredictBox writes it; the others get dynamic[index] = their
+  // dynamic index (and out left as it is), for PredictDynamic. A dynamic index is its state's for
+  // the shard's life: dynamic states are only ever added.
   void PredictBoxConstant(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                          float* out, uint8_t* varying) const;
+                          float* out, uint32_t* dynamic) const;
+  // out[at[i]] = p(t) of dynamic state dynamic[i], as PredictBox gives it (published models through
+  // the region kernel together): the second half, at each time, without a lookup per state.
+  void PredictDynamic(std::span<const uint32_t> dynamic, std::span<const uint32_t> at,
+                      const model::PhasorTable& table, const PredictOptions& options, float* out) const;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const;
   // Whether the state was ever observed (cheap: one brick lookup).
   bool Observed(uint64_t key) const;
@@ -191,9 +196,13 @@ class Shard {
   void ObserveBesidesSpectrum(uint32_t d, double t, float value) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   uint32_t AddDynamic(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   void MarkDirty(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
-  // PredictBox, or PredictBoxConstant when `varying` is not null.
+  // PredictBox, or PredictBoxConstant when `dynamic` is not null.
   void PredictBoxCells(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                       float* out, uint8_t* varying) const ABSL_LOCKS_EXCLUDED(mutex_);
+                       float* out, uint32_t* dynamic) const ABSL_LOCKS_EXCLUDED(mutex_);
+  // out[at[i]] = p(t) of the state behind handles[i], for i < handles.size() ≤ 512: the published
+  // models through the region kernel together, the others one by one.
+  void PredictHandles(std::span<const uint32_t> handles, const uint32_t* at, const model::PhasorTable& table,
+                      const PredictOptions& options, float* out) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // Calls visit(handle, index in the box) for every cell of `box` held by this shard, brick by
   // brick, and end_brick() after each brick's cells.
   template <typename Visit, typename EndBrick>

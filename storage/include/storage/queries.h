@@ -39,8 +39,12 @@ struct BoxSeries {
   // The varying cells' indices in the box, ascending, and their keys.
   std::vector<uint32_t> varying;
   std::vector<uint64_t> varying_keys;
-  // The map store's: positions in `varying` by shard.
-  std::vector<std::vector<uint32_t>> varying_by_shard;
+  // The map store's, by shard: the varying cells' states (dynamic indices, in record order) and
+  // their positions in `varying`.
+  struct ShardPart {
+    std::vector<uint32_t> dynamic, at;
+  };
+  std::vector<ShardPart> shards;
 };
 
 // A copy of one state's complete model, for the full-model view and for tests.
