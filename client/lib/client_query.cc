@@ -38,17 +38,25 @@ absl::StatusOr<Predictions> Client::Predict(absl::string_view map, const StateSe
 
 namespace {
 
-// The box of a region request and its shape as the daemon reads it: a 2-D box may leave z at 0 in
-// both corners.
-template <typename Request>
-GridShape SetBox(const Cell& lo, const Cell& hi, Request& request) {
-  request.mutable_lo()->set_x(lo.x);
-  request.mutable_lo()->set_y(lo.y);
-  request.mutable_lo()->set_z(lo.z);
-  request.mutable_hi()->set_x(hi.x);
-  request.mutable_hi()->set_y(hi.y);
-  request.mutable_hi()->set_z(hi.z);
+// What a region request and a series request share, from the query (RegionQuery or
+// RegionSeriesQuery): the map, the box, the options, the output. Returns the box's shape as the
+// daemon reads it: a 2-D box may leave z at 0 in both corners.
+template <typename Query, typename Request>
+GridShape SetRegion(absl::string_view map, const Query& query, Request& request) {
+  request.set_map(std::string(map));
+  request.mutable_lo()->set_x(query.lo.x);
+  request.mutable_lo()->set_y(query.lo.y);
+  request.mutable_lo()->set_z(query.lo.z);
+  request.mutable_hi()->set_x(query.hi.x);
+  request.mutable_hi()->set_y(query.hi.y);
+  request.mutable_hi()->set_z(query.hi.z);
+  *request.mutable_options() = ToProto(query.model);
+  request.set_output(query.output);
+  request.set_confidence(query.confidence);
+  request.set_chunk_cells(query.chunk_cells);
   const auto extent = [](uint32_t l, uint32_t h) { return h > l ? h - l : 0; };
+  const Cell& lo = query.lo;
+  const Cell& hi = query.hi;
   return {extent(lo.x, hi.x), extent(lo.y, hi.y), lo.z == 0 && hi.z == 0 ? 1 : extent(lo.z, hi.z)};
 }
 
@@ -84,13 +92,8 @@ absl::Status ReadRegionStream(Connection& connection, const CallOptions& call, a
 absl::StatusOr<RegionArray> Client::PredictRegion(absl::string_view map, const RegionQuery& query,
                                                   const CallOptions& call) const {
   v1::PredictRegionRequest request;
-  request.set_map(std::string(map));
-  const GridShape shape = SetBox(query.lo, query.hi, request);
+  const GridShape shape = SetRegion(map, query, request);
   request.set_time(query.time);
-  *request.mutable_options() = ToProto(query.model);
-  request.set_output(query.output);
-  request.set_confidence(query.confidence);
-  request.set_chunk_cells(query.chunk_cells);
   absl::StatusOr<RegionArray> result = absl::UnknownError("no attempt");
   absl::Status status = ReadRegionStream<v1::PredictRegionResponse>(
       *connection_, call, map,
@@ -103,13 +106,8 @@ absl::StatusOr<RegionArray> Client::PredictRegion(absl::string_view map, const R
 absl::StatusOr<RegionSeries> Client::PredictRegionSeries(absl::string_view map, const RegionSeriesQuery& query,
                                                          const CallOptions& call) const {
   v1::PredictRegionSeriesRequest request;
-  request.set_map(std::string(map));
-  const GridShape shape = SetBox(query.lo, query.hi, request);
+  const GridShape shape = SetRegion(map, query, request);
   request.mutable_times()->Assign(query.times.begin(), query.times.end());
-  *request.mutable_options() = ToProto(query.model);
-  request.set_output(query.output);
-  request.set_confidence(query.confidence);
-  request.set_chunk_cells(query.chunk_cells);
   absl::StatusOr<RegionSeries> result = absl::UnknownError("no attempt");
   absl::Status status = ReadRegionStream<v1::PredictRegionSeriesResponse>(
       *connection_, call, map,
