@@ -196,9 +196,6 @@ class Shard {
   void ObserveBesidesSpectrum(uint32_t d, double t, float value) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   uint32_t AddDynamic(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   void MarkDirty(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
-  // PredictBox, or PredictBoxConstant when `dynamic` is not null.
-  void PredictBoxCells(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                       float* out, uint32_t* dynamic) const ABSL_LOCKS_EXCLUDED(mutex_);
   // out[at[i]] = p(t) of the state behind handles[i], for i < handles.size() ≤ 512: the published
   // models through the region kernel together, the others one by one.
   void PredictHandles(std::span<const uint32_t> handles, const uint32_t* at, const model::PhasorTable& table,
