@@ -983,8 +983,7 @@ std::vector<float> MapStoreImpl::PredictWithObserved(std::span<const uint64_t> k
   return PredictKeys(keys, times, options, observed.data());
 }
 
-absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
-                                  std::vector<float>& out) const {
+absl::Status MapStoreImpl::CheckBox(const CellBox& box) const {
   if (info_.kind != MapKind::kGrid) {
     return absl::FailedPreconditionError(absl::StrCat("map ", info_.name, " is not a grid: it has no boxes"));
   }
@@ -995,12 +994,69 @@ absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const Predic
                                                 ", got [", box.lo[a], ", ", box.hi[a], ")"));
     }
   }
+  return absl::OkStatus();
+}
+
+absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
+                                  std::vector<float>& out) const {
+  if (absl::Status s = CheckBox(box); !s.ok()) return s;
   const model::PhasorTable table(settings_->periods, t);
   out.assign(box.cell_count(), kUnobservedProbability);
   ParallelForShards(
       shards_.size(), [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); },
       /*parallel=*/box.cell_count() >= (1u << 16));
   return absl::OkStatus();
+}
+
+absl::StatusOr<BoxSeries> MapStoreImpl::PlanBoxSeries(const CellBox& box, double t,
+                                                      const PredictOptions& options) const {
+  if (absl::Status s = CheckBox(box); !s.ok()) return s;
+  const model::PhasorTable table(settings_->periods, t);
+  BoxSeries plan;
+  plan.box = box;
+  plan.options = options;
+  plan.constant.assign(box.cell_count(), kUnobservedProbability);
+  constexpr uint32_t kConstant = UINT32_MAX;
+  std::vector<uint32_t> dynamic(box.cell_count(), kConstant);
+  ParallelForShards(
+      shards_.size(),
+      [&](size_t s) { shards_[s]->PredictBoxConstant(box, table, options, plan.constant.data(), dynamic.data()); },
+      /*parallel=*/box.cell_count() >= (1u << 16));
+  const GridKeys keys = info_.grid.keys();
+  const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
+  plan.shards.resize(shards_.size());
+  for (uint64_t i = 0; i < dynamic.size(); ++i) {
+    if (dynamic[i] == kConstant) continue;
+    const uint64_t key = keys.Key(static_cast<uint32_t>(box.lo[0] + i % nx), static_cast<uint32_t>(box.lo[1] + i / nx % ny),
+                                  static_cast<uint32_t>(box.lo[2] + i / (nx * ny)));
+    BoxSeries::ShardPart& part = plan.shards[ShardOf(key, info_.shards)];
+    part.dynamic.push_back(dynamic[i]);
+    part.at.push_back(static_cast<uint32_t>(plan.varying.size()));
+    plan.varying.push_back(static_cast<uint32_t>(i));
+    plan.varying_keys.push_back(key);
+  }
+  // In record order within each shard, so that the kernel reads the models front to back.
+  for (BoxSeries::ShardPart& part : plan.shards) {
+    std::vector<uint32_t> order(part.dynamic.size());
+    for (uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return part.dynamic[a] < part.dynamic[b]; });
+    BoxSeries::ShardPart sorted;
+    for (const uint32_t k : order) {
+      sorted.dynamic.push_back(part.dynamic[k]);
+      sorted.at.push_back(part.at[k]);
+    }
+    part = std::move(sorted);
+  }
+  return plan;
+}
+
+void MapStoreImpl::PredictBoxSeries(const BoxSeries& plan, double t, std::vector<float>& out) const {
+  out.resize(plan.varying_keys.size());
+  const model::PhasorTable table(settings_->periods, t);
+  ParallelForShards(
+      shards_.size(),
+      [&](size_t s) { shards_[s]->PredictDynamic(plan.shards[s].dynamic, plan.shards[s].at, table, plan.options, out.data()); },
+      /*parallel=*/out.size() >= kParallelPredictions);
 }
 
 std::optional<StateSnapshot> MapStoreImpl::Snapshot(uint64_t key) const { return ShardFor(key).Snapshot(key); }

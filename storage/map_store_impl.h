@@ -59,6 +59,8 @@ class MapStoreImpl final : public MapStore {
                              const PredictOptions& options) const override;
   absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
                           std::vector<float>& out) const override;
+  absl::StatusOr<BoxSeries> PlanBoxSeries(const CellBox& box, double t, const PredictOptions& options) const override;
+  void PredictBoxSeries(const BoxSeries& plan, double t, std::vector<float>& out) const override;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const override;
   std::vector<uint8_t> Observed(std::span<const uint64_t> keys) const override;
   std::vector<float> PredictWithObserved(std::span<const uint64_t> keys, std::span<const double> times,
@@ -171,6 +173,8 @@ class MapStoreImpl final : public MapStore {
     return queued_observations_ == 0 || queued_observations_ + n <= options_.max_queued_observations;
   }
   const Shard& ShardFor(uint64_t key) const { return *shards_[ShardOf(key, info_.shards)]; }
+  // OK when `box` is a non-empty box of this grid (FailedPrecondition on a generic map, OutOfRange).
+  absl::Status CheckBox(const CellBox& box) const;
   // at[s]: the positions in `keys` of shard s's keys, in order.
   std::vector<std::vector<uint32_t>> PositionsByShard(std::span<const uint64_t> keys) const;
   // Predict's work; fills observed (keys.size() bytes) at the first time when it is not null.

@@ -128,6 +128,17 @@ class Shard {
   // (x fastest, then y, then z); cells it does not hold are left as they are.
   void PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
                   float* out) const;
+  // PredictBox's first half for a box at many times: of the cells of `box` held by this shard,
+  // those whose p(t) cannot change with t under `options` (VariesWithTime) get p(t) written into
+  // out[index in the box], exactly as PredictBox writes it; the others get dynamic[index] = their
+  // dynamic index (and out left as it is), for PredictDynamic. A dynamic index is its state's for
+  // the shard's life: dynamic states are only ever added.
+  void PredictBoxConstant(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
+                          float* out, uint32_t* dynamic) const;
+  // out[at[i]] = p(t) of dynamic state dynamic[i], as PredictBox gives it (published models through
+  // the region kernel together): the second half, at each time, without a lookup per state.
+  void PredictDynamic(std::span<const uint32_t> dynamic, std::span<const uint32_t> at,
+                      const model::PhasorTable& table, const PredictOptions& options, float* out) const;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const;
   // Whether the state was ever observed (cheap: one brick lookup).
   bool Observed(uint64_t key) const;
@@ -189,6 +200,19 @@ class Shard {
   // Only the slot's published model changes: the next checkpoint writes its published record
   // alone, unless something else marks the slot dirty meanwhile.
   void MarkPublishedDirty(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // out[at[i]] = p(t) of the state behind handles[i], for i < handles.size() ≤ 512: the published
+  // models through the region kernel together, the others one by one.
+  void PredictHandles(std::span<const uint32_t> handles, const uint32_t* at, const model::PhasorTable& table,
+                      const PredictOptions& options, float* out) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  // Calls visit(handle, index in the box) for every cell of `box` held by this shard, brick by
+  // brick, and end_brick() after each brick's cells.
+  template <typename Visit, typename EndBrick>
+  void ForEachBoxCell(const CellBox& box, Visit visit, EndBrick end_brick) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  // Whether p(t) of the state behind a handle may change with t under `options`: not for an
+  // unobserved cell (0.5), a never changed one (its value; persistence agrees), a dynamic state
+  // without a published model (the mean of its observations) or with one used at order 0 (α0) —
+  // unless persistence blends in the last observation, which decays with t.
+  bool VariesWithTime(uint32_t handle, const PredictOptions& options) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // p(t) of the state behind a handle (see kStaticHandle).
   float PredictHandle(uint32_t handle, const model::PhasorTable& table, const PredictOptions& options) const
       ABSL_SHARED_LOCKS_REQUIRED(mutex_);

@@ -319,6 +319,41 @@ TEST_F(ClientLibraryTest, RegionIsAssembledFromManyChunksInEveryOutput) {
   EXPECT_EQ(outside.status().code(), absl::StatusCode::kOutOfRange);
 }
 
+// The series as frames: each equals PredictRegion at its time; only the two dynamic cells of the
+// box are sent per time.
+TEST_F(ClientLibraryTest, RegionSeriesFramesArePredictRegionAtEachTime) {
+  Create(GridMap("lab"));
+  IngestTwoWeeks("lab");
+  const double noon = kStart + 14 * kDay + 12 * 3600;
+  client::RegionSeriesQuery query;
+  query.lo = {1, 2, 0};
+  query.hi = {6, 7, 1};
+  query.chunk_cells = 7;
+  for (int h = 0; h < 24; h += 3) query.times.push_back(noon + h * 3600.0);
+  for (const v1::RegionOutput output : {v1::REGION_OUTPUT_FLOAT, v1::REGION_OUTPUT_UINT8}) {
+    query.output = output;
+    auto series = client_->PredictRegionSeries("lab", query);
+    ASSERT_TRUE(series.ok()) << series.status();
+    ASSERT_EQ(series->frames.size(), query.times.size());
+    EXPECT_EQ(series->varying_cells, 2u);  // (2, 3) and (4, 5)
+    EXPECT_EQ(series->values_received, 23u + 2 * query.times.size());
+    client::RegionQuery single;
+    single.lo = query.lo;
+    single.hi = query.hi;
+    single.output = output;
+    for (size_t t = 0; t < query.times.size(); ++t) {
+      single.time = query.times[t];
+      auto region = client_->PredictRegion("lab", single);
+      ASSERT_TRUE(region.ok()) << region.status();
+      EXPECT_EQ(series->frames[t].shape, region->shape);
+      EXPECT_EQ(series->frames[t].floats, region->floats) << t;
+      EXPECT_EQ(series->frames[t].bytes, region->bytes) << t;
+    }
+  }
+  query.times = {};
+  EXPECT_EQ(client_->PredictRegionSeries("lab", query).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
 TEST_F(ClientLibraryTest, AnomaliesFlagObservationsAgainstThePattern) {
   Create(GridMap("lab"));
   IngestTwoWeeks("lab");

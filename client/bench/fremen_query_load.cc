@@ -2,6 +2,11 @@
 // "Targets") and prints medians:
 //   - PredictRegion of a box (default 1000×1000 = 1M cells) delivered as FLOAT and as UINT8:
 //     seconds per box and cells/s (target ≥ 100M cells/s);
+//   - PredictRegionSeries of the same box at --series-times times (default 96: a day every 15
+//     minutes) as FLOAT and UINT8: seconds per call, delivered cell-predictions/s (cells × times /
+//     seconds) and the values and bytes on the wire, next to two ceilings of the same run: the box
+//     asked time by time (cells / PredictRegion's median) and the loopback byte rate of the single-
+//     time PredictRegion stream;
 //   - single-state Predict: latency p50/p99 with one call in flight (targets p50 ≤ 200 µs,
 //     p99 ≤ 1 ms) and the sustained rate, with one and with several calls in flight on one channel,
 //     and the rate of predictions when each call asks for many states (the original FremenServer:
@@ -53,6 +58,8 @@ struct Options {
   uint32_t scans = 56;        // --create: scans of the whole grid
   double scan_interval = 21600;  // seconds between scans (4 a day: 14 days)
   int region_reps = 15;
+  int series_times = 96;  // PredictRegionSeries: times a call
+  int series_reps = 7;
   int predict_calls = 20000;
   int concurrency = 8;
   int batch = 1000;          // states per call of the batched Predict
@@ -65,9 +72,9 @@ struct Options {
 const char kUsage[] =
     "usage: fremen_query_load [--address=HOST:PORT] [--map=NAME] [--token=TOKEN] [--create]\n"
     "                         [--size=CELLS] [--scans=N] [--scan-interval=S] [--region-reps=N]\n"
-    "                         [--predict-calls=N] [--concurrency=N] [--batch=STATES]\n"
-    "                         [--large-batch=STATES] [--windows=N] [--window-predictions=N]\n"
-    "                         [--batched-only]\n";
+    "                         [--series-times=N] [--series-reps=N] [--predict-calls=N]\n"
+    "                         [--concurrency=N] [--batch=STATES] [--large-batch=STATES]\n"
+    "                         [--windows=N] [--window-predictions=N] [--batched-only]\n";
 
 Options Parse(int argc, char** argv) {
   Options o;
@@ -91,6 +98,8 @@ Options Parse(int argc, char** argv) {
     else if (key == "scans") o.scans = static_cast<uint32_t>(std::stoul(value));
     else if (key == "scan-interval") o.scan_interval = std::stod(value);
     else if (key == "region-reps") o.region_reps = std::stoi(value);
+    else if (key == "series-times") o.series_times = std::stoi(value);
+    else if (key == "series-reps") o.series_reps = std::stoi(value);
     else if (key == "predict-calls") o.predict_calls = std::stoi(value);
     else if (key == "concurrency") o.concurrency = std::stoi(value);
     else if (key == "batch") o.batch = std::stoi(value);
@@ -123,7 +132,14 @@ class Bench {
   }
 
   bool CreateAndFill();
-  void Region(v1::RegionOutput output, const char* name);
+  // The median seconds of a box and its wire bytes (0 on failure).
+  struct RegionRun {
+    double seconds = 0;
+    uint64_t wire_bytes = 0;
+  };
+  RegionRun Region(v1::RegionOutput output, const char* name);
+  // `single`: the same box's PredictRegion, for the ceilings.
+  void RegionSeries(v1::RegionOutput output, const char* name, const RegionRun& single);
   void Predict();
   // The rate of predictions when calls ask for many states: `windows` windows each of --batch and
   // --large-batch states a call, with 1 and with --concurrency calls in flight, beside two ceilings
@@ -264,7 +280,7 @@ bool Bench::Update() {
   return true;
 }
 
-void Bench::Region(v1::RegionOutput output, const char* name) {
+Bench::RegionRun Bench::Region(v1::RegionOutput output, const char* name) {
   v1::PredictRegionRequest request;
   request.set_map(o_.map);
   request.mutable_hi()->set_x(o_.size);
@@ -273,6 +289,7 @@ void Bench::Region(v1::RegionOutput output, const char* name) {
   request.set_output(output);
   const uint64_t cells = uint64_t{o_.size} * o_.size;
   std::vector<double> seconds;
+  uint64_t wire_bytes = 0;
   for (int rep = 0; rep < o_.region_reps; ++rep) {
     grpc::ClientContext context;
     Prepare(context);
@@ -280,23 +297,78 @@ void Bench::Region(v1::RegionOutput output, const char* name) {
     auto reader = query_->PredictRegion(&context, request);
     v1::PredictRegionResponse chunk;
     uint64_t received = 0, chunks = 0;
+    wire_bytes = 0;
     while (reader->Read(&chunk)) {
       received += chunk.float_values_size() + chunk.bytes_values().size();
+      wire_bytes += chunk.ByteSizeLong();
       ++chunks;
     }
     const grpc::Status status = reader->Finish();
     if (!status.ok() || received != cells) {
       std::fprintf(stderr, "PredictRegion %s: %s (%llu of %llu cells)\n", name, status.error_message().c_str(),
                    static_cast<unsigned long long>(received), static_cast<unsigned long long>(cells));
-      return;
+      return {};
     }
     seconds.push_back(Seconds(Clock::now() - start));
     if (rep == 0) std::printf("PredictRegion %-5s %llu cells in %llu chunks\n", name,
                               static_cast<unsigned long long>(cells), static_cast<unsigned long long>(chunks));
   }
   const double median = Median(seconds);
-  std::printf("PredictRegion %-5s median %.2f ms per box = %.1fM cells/s (best %.2f ms)\n", name, median * 1e3,
-              static_cast<double>(cells) / median / 1e6, *std::min_element(seconds.begin(), seconds.end()) * 1e3);
+  std::printf("PredictRegion %-5s median %.2f ms per box = %.1fM cells/s (best %.2f ms), %.0f MB/s on the wire\n",
+              name, median * 1e3, static_cast<double>(cells) / median / 1e6,
+              *std::min_element(seconds.begin(), seconds.end()) * 1e3, wire_bytes / median / 1e6);
+  return {median, wire_bytes};
+}
+
+void Bench::RegionSeries(v1::RegionOutput output, const char* name, const RegionRun& single) {
+  v1::PredictRegionSeriesRequest request;
+  request.set_map(o_.map);
+  request.mutable_hi()->set_x(o_.size);
+  request.mutable_hi()->set_y(o_.size);
+  // A day after the scans, evenly spaced (96: every 15 minutes).
+  const double day_start = kT0 + o_.scan_interval * o_.scans;
+  for (int i = 0; i < o_.series_times; ++i) request.add_times(day_start + 86400.0 * i / o_.series_times);
+  request.set_output(output);
+  const uint64_t cells = uint64_t{o_.size} * o_.size;
+  std::vector<double> seconds;
+  uint64_t values = 0, wire_bytes = 0, varying = 0;
+  for (int rep = 0; rep < o_.series_reps; ++rep) {
+    grpc::ClientContext context;
+    Prepare(context);
+    const auto start = Clock::now();
+    auto reader = query_->PredictRegionSeries(&context, request);
+    v1::PredictRegionSeriesResponse chunk;
+    values = wire_bytes = 0;
+    while (reader->Read(&chunk)) {
+      values += chunk.float_values_size() + chunk.bytes_values().size();
+      wire_bytes += chunk.ByteSizeLong();
+      varying = chunk.varying_cells();
+    }
+    const grpc::Status status = reader->Finish();
+    const uint64_t expected = cells - varying + varying * static_cast<uint64_t>(o_.series_times);
+    if (!status.ok() || values != expected) {
+      std::fprintf(stderr, "PredictRegionSeries %s: %s (%llu of %llu values)\n", name,
+                   status.error_message().c_str(), static_cast<unsigned long long>(values),
+                   static_cast<unsigned long long>(expected));
+      return;
+    }
+    seconds.push_back(Seconds(Clock::now() - start));
+  }
+  const double median = Median(seconds);
+  const double delivered = static_cast<double>(cells) * o_.series_times;
+  std::printf("PredictRegionSeries %-5s %d times, %llu of %llu cells varying: %.1fM values, %.1f MB on the wire\n",
+              name, o_.series_times, static_cast<unsigned long long>(varying), static_cast<unsigned long long>(cells),
+              values / 1e6, wire_bytes / 1e6);
+  std::printf("PredictRegionSeries %-5s median %.2f ms per call = %.0fM cell-predictions/s delivered (best %.2f ms), "
+              "%.0f MB/s on the wire\n",
+              name, median * 1e3, delivered / median / 1e6, *std::min_element(seconds.begin(), seconds.end()) * 1e3,
+              wire_bytes / median / 1e6);
+  if (single.seconds > 0) {
+    std::printf("  ceilings of this run: the box time by time %.0fM cell-predictions/s (the series delivers %.1fx that); "
+                "PredictRegion's wire rate %.0f MB/s\n",
+                cells / single.seconds / 1e6, delivered / median / (cells / single.seconds),
+                single.wire_bytes / single.seconds / 1e6);
+  }
 }
 
 std::vector<double> Bench::PredictLoop(int calls, int states, uint64_t seed, bool* ok) {
@@ -480,8 +552,10 @@ int main(int argc, char** argv) {
   Bench bench(options);
   if (options.create && !bench.CreateAndFill()) return 1;
   if (!options.batched_only) {
-    bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT");
-    bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8");
+    const auto floats = bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT");
+    const auto bytes = bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8");
+    bench.RegionSeries(v1::REGION_OUTPUT_FLOAT, "FLOAT", floats);
+    bench.RegionSeries(v1::REGION_OUTPUT_UINT8, "UINT8", bytes);
     bench.Predict();
   }
   bench.BatchedPredict();

@@ -32,6 +32,7 @@
 #include "client/lib/ingest_session.h"
 #include "client/lib/options.h"
 #include "client/lib/region_assembler.h"
+#include "client/lib/region_series_assembler.h"
 #include "client/lib/state_set.h"
 #include "fremen/v1/admin.pb.h"
 #include "fremen/v1/maps.pb.h"
@@ -77,6 +78,19 @@ struct RegionQuery {
   // For REGION_OUTPUT_STATES.
   float confidence = 0.5f;
   // Cells per chunk; 0 = the daemon's choice (just under 1 MiB of values).
+  uint32_t chunk_cells = 0;
+};
+
+// A box [lo, hi) of a grid at many times (PredictRegionSeries).
+struct RegionSeriesQuery {
+  // As RegionQuery's: the box, the model options, the output.
+  Cell lo;
+  Cell hi;
+  // REQUIRES: 1 to 1000 times.
+  std::vector<double> times;
+  ModelOptions model;
+  v1::RegionOutput output = v1::REGION_OUTPUT_FLOAT;
+  float confidence = 0.5f;
   uint32_t chunk_cells = 0;
 };
 
@@ -136,6 +150,11 @@ class Client {
   // The box as one dense array of its shape (hi − lo), assembled from the streamed chunks.
   absl::StatusOr<RegionArray> PredictRegion(absl::string_view map, const RegionQuery& query,
                                             const CallOptions& call = {}) const;
+  // The box at each time, one dense array per time, assembled from the stream that sends the cells
+  // whose prediction cannot change with time once (a box of at most 2^22 cells; the frames take
+  // times × cells values of memory here).
+  absl::StatusOr<RegionSeries> PredictRegionSeries(absl::string_view map, const RegionSeriesQuery& query,
+                                                   const CallOptions& call = {}) const;
   // The n states of `group` most likely 1 at `time`, most likely first (generic maps).
   absl::StatusOr<std::vector<v1::ScoredState>> TopStates(absl::string_view map, absl::string_view group, double time,
                                                          uint32_t n, const ModelOptions& model = {},

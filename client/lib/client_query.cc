@@ -36,9 +36,13 @@ absl::StatusOr<Predictions> Client::Predict(absl::string_view map, const StateSe
   return predictions;
 }
 
-absl::StatusOr<RegionArray> Client::PredictRegion(absl::string_view map, const RegionQuery& query,
-                                                  const CallOptions& call) const {
-  v1::PredictRegionRequest request;
+namespace {
+
+// What a region request and a series request share, from the query (RegionQuery or
+// RegionSeriesQuery): the map, the box, the options, the output. Returns the box's shape as the
+// daemon reads it: a 2-D box may leave z at 0 in both corners.
+template <typename Query, typename Request>
+GridShape SetRegion(absl::string_view map, const Query& query, Request& request) {
   request.set_map(std::string(map));
   request.mutable_lo()->set_x(query.lo.x);
   request.mutable_lo()->set_y(query.lo.y);
@@ -46,21 +50,26 @@ absl::StatusOr<RegionArray> Client::PredictRegion(absl::string_view map, const R
   request.mutable_hi()->set_x(query.hi.x);
   request.mutable_hi()->set_y(query.hi.y);
   request.mutable_hi()->set_z(query.hi.z);
-  request.set_time(query.time);
   *request.mutable_options() = ToProto(query.model);
   request.set_output(query.output);
   request.set_confidence(query.confidence);
   request.set_chunk_cells(query.chunk_cells);
-  // The shape as the daemon reads the box: a 2-D box may leave z at 0 in both corners.
-  const auto extent = [](uint32_t lo, uint32_t hi) { return hi > lo ? hi - lo : 0; };
-  GridShape shape{extent(query.lo.x, query.hi.x), extent(query.lo.y, query.hi.y),
-                  query.lo.z == 0 && query.hi.z == 0 ? 1 : extent(query.lo.z, query.hi.z)};
-  absl::StatusOr<RegionArray> result = absl::UnknownError("no attempt");
-  // A stream broken half way is retried whole: the chunks of one attempt make one array.
-  absl::Status status = connection_->CallIdempotent(call, map, [&](grpc::ClientContext& context) {
-    RegionAssembler assembler(shape, query.output);
-    auto reader = connection_->query().PredictRegion(&context, request);
-    v1::PredictRegionResponse chunk;
+  const auto extent = [](uint32_t l, uint32_t h) { return h > l ? h - l : 0; };
+  const Cell& lo = query.lo;
+  const Cell& hi = query.hi;
+  return {extent(lo.x, hi.x), extent(lo.y, hi.y), lo.z == 0 && hi.z == 0 ? 1 : extent(lo.z, hi.z)};
+}
+
+// Reads a region stream into `assembler`, then its result into `result`. A stream broken half way
+// is retried whole (the chunks of one attempt make one answer): `make` gives each attempt a fresh
+// assembler.
+template <typename Response, typename Result, typename Open, typename MakeAssembler>
+absl::Status ReadRegionStream(Connection& connection, const CallOptions& call, absl::string_view map, Open open,
+                              MakeAssembler make, absl::StatusOr<Result>& result) {
+  return connection.CallIdempotent(call, map, [&](grpc::ClientContext& context) {
+    auto assembler = make();
+    auto reader = open(context);
+    Response chunk;
     absl::Status assembled;
     while (reader->Read(&chunk)) {
       if (assembled = assembler.Add(chunk); !assembled.ok()) {
@@ -76,6 +85,35 @@ absl::StatusOr<RegionArray> Client::PredictRegion(absl::string_view map, const R
     if (finished.ok()) result = assembler.Finish();
     return finished;
   });
+}
+
+}  // namespace
+
+absl::StatusOr<RegionArray> Client::PredictRegion(absl::string_view map, const RegionQuery& query,
+                                                  const CallOptions& call) const {
+  v1::PredictRegionRequest request;
+  const GridShape shape = SetRegion(map, query, request);
+  request.set_time(query.time);
+  absl::StatusOr<RegionArray> result = absl::UnknownError("no attempt");
+  absl::Status status = ReadRegionStream<v1::PredictRegionResponse>(
+      *connection_, call, map,
+      [&](grpc::ClientContext& context) { return connection_->query().PredictRegion(&context, request); },
+      [&] { return RegionAssembler(shape, query.output); }, result);
+  if (!status.ok()) return status;
+  return result;
+}
+
+absl::StatusOr<RegionSeries> Client::PredictRegionSeries(absl::string_view map, const RegionSeriesQuery& query,
+                                                         const CallOptions& call) const {
+  v1::PredictRegionSeriesRequest request;
+  const GridShape shape = SetRegion(map, query, request);
+  request.mutable_times()->Assign(query.times.begin(), query.times.end());
+  absl::StatusOr<RegionSeries> result = absl::UnknownError("no attempt");
+  absl::Status status = ReadRegionStream<v1::PredictRegionSeriesResponse>(
+      *connection_, call, map,
+      [&](grpc::ClientContext& context) { return connection_->query().PredictRegionSeries(&context, request); },
+      [&] { return RegionSeriesAssembler(shape, query.output, static_cast<uint32_t>(query.times.size())); },
+      result);
   if (!status.ok()) return status;
   return result;
 }

@@ -8,6 +8,7 @@
 #include "server/rpc/map_lookup.h"
 #include "server/convert/query_args.h"
 #include "server/convert/query_convert.h"
+#include "server/services/region_series_stream.h"
 #include "server/services/region_stream.h"
 #include "server/services/state_page.h"
 #include "server/convert/state_refs.h"
@@ -254,6 +255,11 @@ grpc::ServerUnaryReactor* QueryServiceImpl::Predict(grpc::CallbackServerContext*
 grpc::ServerWriteReactor<v1::PredictRegionResponse>* QueryServiceImpl::PredictRegion(
     grpc::CallbackServerContext* context, const v1::PredictRegionRequest* request) {
   return RegionStream::Start(deps_, context, *request);
+}
+
+grpc::ServerWriteReactor<v1::PredictRegionSeriesResponse>* QueryServiceImpl::PredictRegionSeries(
+    grpc::CallbackServerContext* context, const v1::PredictRegionSeriesRequest* request) {
+  return RegionSeriesStream::Start(deps_, context, *request);
 }
 
 grpc::ServerUnaryReactor* QueryServiceImpl::TopStates(grpc::CallbackServerContext* context,

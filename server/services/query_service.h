@@ -6,8 +6,8 @@
 // Small predictions run inline on the gRPC thread (a single-state Predict is a few microseconds of
 // work; the hop to a pool would cost more); large ones, and the methods whose cost grows with the
 // map or a state's history (TopStates, GetStateModel, Reconstruct, GetMapStats, ListStates), run on the
-// blocking pool so that they cannot hold up the gRPC threads. PredictRegion streams
-// (server/services/region_stream.h).
+// blocking pool so that they cannot hold up the gRPC threads. PredictRegion and
+// PredictRegionSeries stream (server/services/region_stream.h, region_series_stream.h).
 // Thread-safety: gRPC calls the handlers from any thread; the service holds no state of its own.
 #pragma once
 
@@ -24,6 +24,8 @@ class QueryServiceImpl final : public v1::QueryService::CallbackService {
                                     v1::PredictResponse* response) override;
   grpc::ServerWriteReactor<v1::PredictRegionResponse>* PredictRegion(
       grpc::CallbackServerContext* context, const v1::PredictRegionRequest* request) override;
+  grpc::ServerWriteReactor<v1::PredictRegionSeriesResponse>* PredictRegionSeries(
+      grpc::CallbackServerContext* context, const v1::PredictRegionSeriesRequest* request) override;
   grpc::ServerUnaryReactor* TopStates(grpc::CallbackServerContext* context, const v1::TopStatesRequest* request,
                                       v1::TopStatesResponse* response) override;
   grpc::ServerUnaryReactor* CheckAnomalies(grpc::CallbackServerContext* context,

@@ -55,6 +55,12 @@ uint64_t ChunkCells(uint64_t requested, v1::RegionOutput output) {
   return requested == 0 ? most : std::min(requested, most);
 }
 
+uint64_t BaseChunkCells(uint64_t max_cells, v1::RegionOutput output) {
+  // At most 8·B + 1 bits a cell: its value (when constant) and its bit of the mask.
+  const uint64_t fit = kMaxChunkBytes * 8 / (8 * BytesPerCell(output) + 1);
+  return std::max<uint64_t>(8, std::min(max_cells, fit) / 8 * 8);
+}
+
 RegionPlan::RegionPlan(const storage::CellBox& box, uint64_t max_cells)
     : box_(box), nx_(box.hi[0] - box.lo[0]), ny_(box.hi[1] - box.lo[1]), nz_(box.hi[2] - box.lo[2]) {
   if (nx_ * ny_ <= max_cells) {
@@ -112,19 +118,18 @@ RegionPlan::Chunk RegionPlan::chunk(uint64_t i) const {
 }
 
 void EncodeRegionValues(v1::RegionOutput output, float confidence, std::span<const float> p,
-                        v1::PredictRegionResponse& out) {
-  out.clear_float_values();
-  out.clear_bytes_values();
+                        google::protobuf::RepeatedField<float>& floats, std::string& bytes) {
+  floats.Clear();
+  bytes.clear();
   switch (output) {
     case v1::REGION_OUTPUT_ENTROPY: {
-      auto& values = *out.mutable_float_values();
+      auto& values = floats;
       values.Reserve(static_cast<int>(p.size()));
       for (float v : p) values.AddAlreadyReserved(static_cast<float>(model::Entropy(v)));
       return;
     }
     case v1::REGION_OUTPUT_UINT8:
     case v1::REGION_OUTPUT_STATES: {
-      std::string& bytes = *out.mutable_bytes_values();
       bytes.resize(p.size());
       auto* b = reinterpret_cast<uint8_t*>(bytes.data());
       if (output == v1::REGION_OUTPUT_UINT8) {
@@ -136,7 +141,7 @@ void EncodeRegionValues(v1::RegionOutput output, float confidence, std::span<con
       return;
     }
     default:  // FLOAT (the caller normalised UNSPECIFIED)
-      out.mutable_float_values()->Add(p.begin(), p.end());
+      floats.Add(p.begin(), p.end());
       return;
   }
 }

@@ -72,6 +72,18 @@ std::vector<std::array<uint32_t, 3>> CellsOf(const storage::CellBox& box) {
 
 // Whatever the chunk size, the chunks are the box's cells in order, each at its offset, none larger
 // than asked.
+// A series' base chunk: whole bytes of mask, and mask plus values within kMaxChunkBytes.
+TEST(RegionPlanTest, BaseChunksFitAMessage) {
+  for (const v1::RegionOutput output : {v1::REGION_OUTPUT_FLOAT, v1::REGION_OUTPUT_UINT8}) {
+    const uint64_t most = BaseChunkCells(ChunkCells(0, output), output);
+    EXPECT_EQ(most % 8, 0u);
+    EXPECT_LE(most / 8 + most * BytesPerCell(output), kMaxChunkBytes);
+    EXPECT_GT((most + 8) / 8 + (most + 8) * BytesPerCell(output), kMaxChunkBytes);  // the most that fits
+  }
+  EXPECT_EQ(BaseChunkCells(300, v1::REGION_OUTPUT_FLOAT), 296u);
+  EXPECT_EQ(BaseChunkCells(1, v1::REGION_OUTPUT_UINT8), 8u);  // never less than a byte of mask
+}
+
 TEST(RegionPlanTest, ChunksTileTheBoxInOrder) {
   const std::vector<storage::CellBox> boxes = {
       {{0, 0, 0}, {1, 1, 1}}, {{3, 2, 1}, {10, 7, 5}}, {{5, 0, 0}, {6, 9, 3}}, {{0, 4, 2}, {13, 5, 3}}};

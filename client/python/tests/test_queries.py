@@ -142,6 +142,27 @@ class QueriesTest(DaemonTestCase):
         chunked = self.client.region("lab", (0, 0), (NX, NY), NOON, chunk_cells=7)
         self.assertEqual(chunked.tolist(), whole.tolist())
 
+    def test_region_series_frames_equal_region_at_each_time(self):
+        self.fill_grid()
+        times = [NOON + h * HOUR for h in range(0, 24, 4)]
+        for output in ("float", "uint8", "entropy", "states"):
+            frames = self.client.region_series("lab", (1, 0), (NX, NY), times, output=output, confidence=0.6,
+                                               chunk_cells=9)
+            self.assertEqual(len(frames), len(times))
+            for t, frame in zip(times, frames):
+                region = self.client.region("lab", (1, 0), (NX, NY), t, output=output, confidence=0.6)
+                self.assertEqual(frame.shape, region.shape)
+                self.assertEqual(frame.tolist(), region.tolist())
+        # The left half varies, the right half and the last row do not.
+        frames = self.client.region_series("lab", (0, 0), (NX, NY), [NOON, NIGHT])
+        self.assertGreater(frames[0][0, 0], 0.7)
+        self.assertLess(frames[1][0, 0], 0.3)
+        self.assertEqual(frames[1][NY - 1, 0], 0.5)
+        with self.assertRaises(fremen.Error) as raised:
+            self.client.region_series("lab", (0, 0), (NX, NY), [])
+        self.assertEqual(raised.exception.code, grpc.StatusCode.INVALID_ARGUMENT)
+        self.assertIn("times", raised.exception.message)
+
     def test_region_of_a_3d_grid_is_shaped_z_y_x(self):
         self.fill_grid("cube", nz=3)
         region = self.client.region("cube", (0, 0, 1), (NX, NY, 3), NOON)

@@ -231,6 +231,14 @@ class MapStore {
   // p(t) of every cell of a box of a grid, x fastest; unobserved cells 0.5.
   virtual absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
                                   std::vector<float>& out) const = 0;
+  // A box at many times, planned once at `t` (one of the times): which cells vary with time and
+  // the others' p. Errors as PredictBox's. The plan holds the models as they are now: a later
+  // batch that makes a constant cell vary is not seen by it.
+  virtual absl::StatusOr<BoxSeries> PlanBoxSeries(const CellBox& box, double t,
+                                                  const PredictOptions& options) const = 0;
+  // out[i] = p(t) of the plan's varying cell i, bit for bit what PredictBox gives it at t; one
+  // phasor table, spread over the shards like PredictBox. `out` is resized to the varying cells.
+  virtual void PredictBoxSeries(const BoxSeries& plan, double t, std::vector<float>& out) const = 0;
   virtual std::optional<StateSnapshot> Snapshot(uint64_t key) const = 0;
   // observed[i]: whether keys[i] was ever observed.
   virtual std::vector<uint8_t> Observed(std::span<const uint64_t> keys) const = 0;

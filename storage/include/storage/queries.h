@@ -1,11 +1,12 @@
-// The types of a map's queries (MapStore::Predict, PredictBox, Snapshot): how to predict, a box of
-// grid cells, and a copy of one state's model.
+// The types of a map's queries (MapStore::Predict, PredictBox, PlanBoxSeries, Snapshot): how to
+// predict, a box of grid cells (and its plan at many times), and a copy of one state's model.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "storage/model/lossless/lossless_history.h"
 #include "storage/model/state_model.h"
@@ -23,6 +24,27 @@ struct CellBox {
   std::array<uint32_t, 3> lo = {0, 0, 0};
   std::array<uint32_t, 3> hi = {0, 0, 0};
   uint64_t cell_count() const { return uint64_t{hi[0] - lo[0]} * (hi[1] - lo[1]) * (hi[2] - lo[2]); }
+};
+
+// A box of a grid at many times (MapStore::PlanBoxSeries, PredictBoxSeries), split once into the
+// cells whose p(t) cannot change with t under the plan's options — unobserved (0.5), never changed,
+// a model without components to use (no published model, or order 0) and no persistence — and
+// the others, the varying cells, predicted at each time.
+struct BoxSeries {
+  CellBox box;
+  PredictOptions options;
+  // p of every constant cell at its index in the box (x fastest, then y, then z), bit for bit
+  // what PredictBox gives at any time; a varying cell's entry is unspecified.
+  std::vector<float> constant;
+  // The varying cells' indices in the box, ascending, and their keys.
+  std::vector<uint32_t> varying;
+  std::vector<uint64_t> varying_keys;
+  // The map store's, by shard: the varying cells' states (dynamic indices, in record order) and
+  // their positions in `varying`.
+  struct ShardPart {
+    std::vector<uint32_t> dynamic, at;
+  };
+  std::vector<ShardPart> shards;
 };
 
 // A copy of one state's complete model, for the full-model view and for tests.
