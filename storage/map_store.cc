@@ -790,12 +790,7 @@ void MapStoreImpl::ApplyToShard(uint32_t s, const Pending& pending, const ScanCo
     shards_[s]->Apply(scan, keys, values);
     return;
   }
-  uint32_t begin = 0;
-  for (const Pending::Run& run : pending.runs[s]) {
-    shards_[s]->Apply(ScanContext(settings_->periods, run.time), keys.subspan(begin, run.end - begin),
-                      values.subspan(begin, run.end - begin));
-    begin = run.end;
-  }
+  shards_[s]->ApplyHistory(settings_->periods, pending.runs[s], keys, values);
 }
 
 void MapStoreImpl::ApplyGroup(std::vector<Pending>& group) {

@@ -93,10 +93,7 @@ class MapStoreImpl final : public MapStore {
     uint64_t fingerprint = 0;  // BatchFingerprint of the record's batch
     // A history's runs by shard: keys[s][previous run's end, end) were observed at `time`. Empty
     // for a scan, whose keys were all observed at batch.time.
-    struct Run {
-      double time;
-      uint32_t end;
-    };
+    using Run = ObservationRun;
     std::vector<std::vector<Run>> runs;
   };
   // Requests the committer serves between groups, in order.

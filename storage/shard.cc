@@ -201,7 +201,25 @@ model::PublishedModel Shard::PublishedOf(uint32_t d) const {
 
 void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::span<const float> values) {
   base::WriterMutexLock lock(&mutex_);
-  const double t = scan.table.time();
+  ApplyAt(scan.table, &scan.phasors, keys, values);
+}
+
+void Shard::ApplyHistory(const model::PeriodSet& periods, std::span<const ObservationRun> runs,
+                         std::span<const uint64_t> keys, std::span<const float> values) {
+  if (runs.empty()) return;
+  base::WriterMutexLock lock(&mutex_);
+  if (!run_table_) run_table_.emplace(periods, runs.front().time);
+  uint32_t begin = 0;
+  for (const ObservationRun& run : runs) {
+    run_table_->Reset(periods, run.time);
+    ApplyAt(*run_table_, nullptr, keys.subspan(begin, run.end - begin), values.subspan(begin, run.end - begin));
+    begin = run.end;
+  }
+}
+
+void Shard::ApplyAt(const model::PhasorTable& table, const model::ScanPhasors<float>* phasors,
+                    std::span<const uint64_t> keys, std::span<const float> values) {
+  const double t = table.time();
   scan_cells_.clear();
   scan_values_.clear();
   // Two passes: first every key's slot (one brick lookup per run of keys), then the states, with
@@ -265,8 +283,14 @@ void Shard::Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::
     }
   }
   const model::ScanScoring scoring{&models_, &errors_, settings_.criterion, settings_.error_half_life};
-  model::ScoreAndApplyScan(spectra_, scoring, scan.table, scan.phasors, scan_cells_, scan_values_);
-  ApplyWide(scan, scoring);
+  if (!scan_cells_.empty()) {
+    if (phasors == nullptr) {
+      run_phasors_.Reset(table);
+      phasors = &run_phasors_;
+    }
+    model::ScoreAndApplyScan(spectra_, scoring, table, *phasors, scan_cells_, scan_values_);
+  }
+  ApplyWide(table, scoring);
   for (size_t j = 0; j < scan_cells_.size(); ++j) {
     const uint32_t d = scan_cells_[j];
     if (spectra_.header(d).n >= widen_at_) wide_.Widen(d, spectra_.body(d));
@@ -280,15 +304,14 @@ void Shard::ObserveBesidesSpectrum(uint32_t d, double t, float value) {
   if (lossless_) (void)lossless_histories_[d].Add(t, value);
 }
 
-void Shard::ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring) {
+void Shard::ApplyWide(const model::PhasorTable& table, const model::ScanScoring& scoring) {
   if (scan_wide_cells_.empty()) return;
-  const double t = scan.table.time();
+  const double t = table.time();
   // Scored against the published P before the fold, as every observation is (prequential).
-  model::ScoreScan(scoring, scan.table, scan_wide_cells_, scan_wide_values_);
-  const model::ScanPhasors<double> phasors(scan.table);
+  model::ScoreScan(scoring, table, scan_wide_cells_, scan_wide_values_);
   for (size_t j = 0; j < scan_wide_cells_.size(); ++j) {
     const uint32_t d = scan_wide_cells_[j];
-    wide_.Fold(d, spectra_.header(d), spectra_.body(d), phasors, scan_wide_values_[j]);
+    wide_.Fold(d, spectra_.header(d), spectra_.body(d), table, scan_wide_values_[j]);
     ObserveBesidesSpectrum(d, t, scan_wide_values_[j]);
   }
   scan_wide_cells_.clear();

@@ -67,6 +67,12 @@ struct ScanContext {
   model::ScanPhasors<float> phasors;
 };
 
+// A history's observations of one shard at one time: keys [previous run's end, end).
+struct ObservationRun {
+  double time;
+  uint32_t end;
+};
+
 class Shard {
  public:
   // Opens (creating when missing) the shard's environment and loads every state into memory.
@@ -79,6 +85,11 @@ class Shard {
   // --- writer side ---
   // Folds accepted observations (keys of this shard, values in [0, 1]) taken at the scan's time.
   void Apply(const ScanContext& scan, std::span<const uint64_t> keys, std::span<const float> values);
+  // The same for a history's runs, in order, under one lock: a history of one state is a run per
+  // observation, so what Apply does once per scan (the lock, the phasors) is here paid per run only
+  // where it is needed.
+  void ApplyHistory(const model::PeriodSet& periods, std::span<const ObservationRun> runs,
+                    std::span<const uint64_t> keys, std::span<const float> values);
   void ApplyLabels(std::span<const StateLabel> labels);
   // --- the update job (docs/update-job.md; storage/shard_publication.cc) ---
   // A publication updates every dynamic state touched (observed) since its own last publication:
@@ -190,8 +201,13 @@ class Shard {
   }
   // Static → dynamic; returns the dynamic index.
   uint32_t Promote(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // Apply's body for observations at table.time(); `phasors` are the table's, or null to compute
+  // them here when a state needs them.
+  void ApplyAt(const model::PhasorTable& table, const model::ScanPhasors<float>* phasors,
+               std::span<const uint64_t> keys, std::span<const float> values) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // Apply's second part: scores and folds the scan's observations of wide states (scan_wide_*).
-  void ApplyWide(const ScanContext& scan, const model::ScanScoring& scoring) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  void ApplyWide(const model::PhasorTable& table, const model::ScanScoring& scoring)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // What every observation of a dynamic state updates besides its spectrum and order errors.
   void ObserveBesidesSpectrum(uint32_t d, double t, float value) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   uint32_t AddDynamic(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
@@ -303,6 +319,9 @@ class Shard {
   std::vector<float> scan_values_;
   std::vector<uint32_t> scan_wide_cells_;
   std::vector<float> scan_wide_values_;
+  // Scratch of ApplyHistory: a run's table and, when needed, its float phasors.
+  std::optional<model::PhasorTable> run_table_;
+  model::ScanPhasors<float> run_phasors_;
 
   uint64_t checkpoint_lsn_ = 0;  // of the last image prepared
   base::Mutex checkpoint_write_mutex_;

@@ -11,6 +11,12 @@ namespace {
 constexpr size_t kMaxPeriods = 65535;
 }
 
+PeriodSet::PeriodSet(std::vector<double> periods) : periods_(std::move(periods)), harmonic_(true) {
+  for (size_t k = 1; k < periods_.size() && harmonic_; ++k) {
+    harmonic_ = periods_[k] == periods_[0] / static_cast<double>(k + 1);
+  }
+}
+
 absl::StatusOr<PeriodSet> PeriodSet::Harmonics(double longest, int count, bool floor_periods) {
   if (!std::isfinite(longest) || longest <= 0) {
     return absl::InvalidArgumentError(absl::StrCat("longest period must be a positive number of seconds, got ", longest));

@@ -33,9 +33,14 @@ class PeriodSet {
   double period(size_t k) const { return periods_[k]; }
   const std::vector<double>& periods() const { return periods_; }
 
+  // Whether T_k = T_1 / k exactly for every k (the default Ω, and Harmonics without floor_periods):
+  // then every phasor is a power of the first one (PhasorTable).
+  bool harmonic() const { return harmonic_; }
+
  private:
-  explicit PeriodSet(std::vector<double> periods) : periods_(std::move(periods)) {}
+  explicit PeriodSet(std::vector<double> periods);
   std::vector<double> periods_;
+  bool harmonic_;
 };
 
 }  // namespace fremen::model

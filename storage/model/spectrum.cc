@@ -6,8 +6,19 @@
 namespace fremen::model {
 
 template <typename Real>
-ScanPhasors<Real>::ScanPhasors(const PhasorTable& table)
-    : time_(table.time()), qs_(table.size() * kRealsPerPeriod, Real(0)), qe_(table.size() * kRealsPerPeriod, Real(0)) {
+ScanPhasors<Real>::ScanPhasors(const PhasorTable& table) {
+  Reset(table);
+}
+
+template <typename Real>
+void ScanPhasors<Real>::Reset(const PhasorTable& table) {
+  time_ = table.time();
+  const size_t reals = table.size() * kRealsPerPeriod;
+  // Only the cos and −sin entries change with the time: the zeros stay when the size does.
+  if (qs_.size() != reals) {
+    qs_.assign(reals, Real(0));
+    qe_.assign(reals, Real(0));
+  }
   for (size_t k = 0; k < table.size(); ++k) {
     const Real c = static_cast<Real>(table.cos(k));
     const Real minus_s = static_cast<Real>(-table.sin(k));
@@ -34,13 +45,14 @@ void BasicSpectrum<Real>::AddBatch(std::span<const Observation> observations, co
   std::vector<std::complex<double>> s_sums(k_count), e_sums(k_count);
   double sum_s = 0;
   double t_first = observations.front().t, t_last = observations.front().t;
+  PhasorTable table(periods, t_first);
   for (const Observation& o : observations) {
     sum_s += o.s;
     t_first = std::min(t_first, o.t);
     t_last = std::max(t_last, o.t);
+    table.Reset(periods, o.t);
     for (size_t k = 0; k < k_count; ++k) {
-      const double phase = ReducedPhase(o.t, periods.period(k));
-      const std::complex<double> e(std::cos(phase), -std::sin(phase));
+      const std::complex<double> e = table.conj_phasor(k);
       e_sums[k] += e;
       s_sums[k] += static_cast<double>(o.s) * e;
     }

@@ -50,21 +50,23 @@ inline constexpr size_t kRealsPerPeriod = 4;
 template <typename Real>
 class ScanPhasors {
  public:
+  ScanPhasors() = default;  // empty until Reset
   explicit ScanPhasors(const PhasorTable& table);
+  // The phasors of another table, in the same storage (no allocation for a table of the same size).
+  void Reset(const PhasorTable& table);
   double time() const { return time_; }
   size_t periods() const { return qs_.size() / kRealsPerPeriod; }
   const Real* qs() const { return qs_.data(); }
   const Real* qe() const { return qe_.data(); }
 
  private:
-  double time_;
+  double time_ = 0;
   std::vector<Real> qs_, qe_;
 };
 
 // Folds one observation (value s at the phasors' time) into a record. The hot path of ingest.
-template <typename Real>
-inline void FoldObservation(SpectrumHeader& h, Real* __restrict body, const ScanPhasors<Real>& ph, float s) {
-  const double t = ph.time();
+// Its header part: counts value s at time t; returns the body's weight d = 1/n (n counting s).
+inline double FoldHeader(SpectrumHeader& h, double t, float s) {
   if (h.n == 0) {
     h.t_first = h.t_last = t;
   } else {
@@ -73,9 +75,14 @@ inline void FoldObservation(SpectrumHeader& h, Real* __restrict body, const Scan
   }
   h.sum_s += s;
   h.n += 1;
+  return 1.0 / h.n;
+}
+
+template <typename Real>
+inline void FoldObservation(SpectrumHeader& h, Real* __restrict body, const ScanPhasors<Real>& ph, float s) {
   // Written as y += d·(target − y), not y = a·y + d·target: a = n/(n+1) rounds to 1 in float
   // once n passes ~1.7e7, which would silently stop the means from averaging.
-  const Real d = static_cast<Real>(1.0 / h.n);
+  const Real d = static_cast<Real>(FoldHeader(h, ph.time(), s));
   const Real sv = s;
   const Real* __restrict qs = ph.qs();
   const Real* __restrict qe = ph.qe();

@@ -5,9 +5,9 @@
 // FREMEN_KERNEL_CLONES on a function definition makes GCC compile it twice, for AVX2 and for the
 // build's own target, and pick one when the binary is loaded (an ifunc resolver: no cost per call).
 // The whole kernel must be inside the cloned function to profit: [[gnu::flatten]] inlines the
-// helpers it calls (FoldObservation, the prefetches) into each clone. Used on ApplyScan and
-// ApplyDenseScan only: region prediction is scalar per cell (its loop over a state's few components
-// is a dependent sum) and measured no better as an AVX2 clone.
+// helpers it calls (FoldObservation, the prefetches) into each clone. Used on ApplyScan,
+// ApplyDenseScan and WideBodies::Fold only: region prediction is scalar per cell (its loop over a
+// state's few components is a dependent sum) and measured no better as an AVX2 clone.
 //
 // The clone is "avx2", deliberately not "arch=x86-64-v3": that one includes FMA, and with FMA the
 // compiler fuses a·b + c into one rounding (C++'s default -ffp-contract=fast), so the AVX2 path would

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "storage/model/kernels/cpu_dispatch.h"
 #include "storage/model/varint.h"
 
 namespace fremen::model {
@@ -18,10 +19,22 @@ double* WideBodies::RowFor(uint32_t record) {
 
 void WideBodies::Widen(uint32_t record, const float* body) { std::copy(body, body + reals_, RowFor(record)); }
 
-void WideBodies::Fold(uint32_t record, SpectrumHeader& header, float* body, const ScanPhasors<double>& phasors,
-                      float s) {
-  double* wide = Row(record);
-  FoldObservation(header, wide, phasors, s);
+// Cloned for AVX2: a state widened by a long history folds every observation of it here.
+FREMEN_KERNEL_CLONES void WideBodies::Fold(uint32_t record, SpectrumHeader& header, float* body,
+                                           const PhasorTable& table, float s) {
+  double* __restrict wide = Row(record);
+  const double d = FoldHeader(header, table.time(), s);
+  const double sv = s;
+  for (size_t k = 0; k < table.size(); ++k) {
+    const double c = table.cos(k), minus_s = -table.sin(k);
+    double* __restrict b = wide + k * kRealsPerPeriod;
+    // FoldObservation's body[i] += d·(s·qs[i] + qe[i] − body[i]) with qs = [c, −sin, 0, 0] and
+    // qe = [0, 0, c, −sin], the zeros written out: the same operations, so the same bits.
+    b[0] += d * (sv * c + 0.0 - b[0]);
+    b[1] += d * (sv * minus_s + 0.0 - b[1]);
+    b[2] += d * (sv * 0.0 + c - b[2]);
+    b[3] += d * (sv * 0.0 + minus_s - b[3]);
+  }
   for (size_t i = 0; i < reals_; ++i) body[i] = static_cast<float>(wide[i]);
 }
 

@@ -37,9 +37,11 @@ class WideBodies {
   // Makes `record` wide, its double body starting as `body` (4K floats); a wide record's double
   // body is replaced.
   void Widen(uint32_t record, const float* body);
-  // Folds value s at the phasors' time into the wide record's header and double body, then mirrors
-  // the double body into the float `body`. REQUIRES: wide(record).
-  void Fold(uint32_t record, SpectrumHeader& header, float* body, const ScanPhasors<double>& phasors, float s);
+  // Folds value s at the table's time into the wide record's header and double body, then mirrors
+  // the double body into the float `body`: bit for bit FoldObservation with the table's
+  // ScanPhasors<double>, without building them (a history pays that per observation).
+  // REQUIRES: wide(record).
+  void Fold(uint32_t record, SpectrumHeader& header, float* body, const PhasorTable& table, float s);
 
   // The double body of a wide record, for checkpoints: a version byte, then 4K little-endian
   // doubles. REQUIRES: wide(record).

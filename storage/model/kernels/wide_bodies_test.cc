@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstring>
+#include <string>
 #include <cmath>
 #include <vector>
 
@@ -29,10 +32,11 @@ TEST(WideBodiesTest, WidenedRecordKeepsItsAccuracyWhereFloatLosesIt) {
   constexpr size_t kTimes = 997;
   std::vector<ScanPhasors<float>> narrow_phasors;
   std::vector<ScanPhasors<double>> wide_phasors;
+  std::vector<PhasorTable> tables;
   for (size_t i = 0; i < kTimes; ++i) {
-    const PhasorTable table(periods, 1.7e9 + 61.3 * i);
-    narrow_phasors.emplace_back(table);
-    wide_phasors.emplace_back(table);
+    tables.emplace_back(periods, 1.7e9 + 61.3 * i);
+    narrow_phasors.emplace_back(tables.back());
+    wide_phasors.emplace_back(tables.back());
   }
   RecordArena arena(periods.size(), 2);  // record 0 is widened, record 1 stays float
   WideBodies wide(periods.size());
@@ -43,7 +47,7 @@ TEST(WideBodiesTest, WidenedRecordKeepsItsAccuracyWhereFloatLosesIt) {
     const size_t t = i % kTimes;
     if (i == kCompactRecordLimit) wide.Widen(0, arena.body(0));
     if (wide.wide(0)) {
-      wide.Fold(0, arena.header(0), arena.body(0), wide_phasors[t], s);
+      wide.Fold(0, arena.header(0), arena.body(0), tables[t], s);
     } else {
       FoldObservation(arena.header(0), arena.body(0), narrow_phasors[t], s);
     }
@@ -75,15 +79,42 @@ TEST(WideBodiesTest, WidenStartsFromTheFloatBodyAndOnlyMarksThatRecord) {
   EXPECT_GE(wide.bytes(), periods.size() * kRealsPerPeriod * sizeof(double));
 
   // A fold of a wide record starting from that body is the fold of the same float body in double.
-  const ScanPhasors<double> phasors(PhasorTable(periods, 1.7e9));
+  const PhasorTable table(periods, 1.7e9);
+  const ScanPhasors<double> phasors(table);
   BasicSpectrum<double> expected(periods.size());
   for (size_t i = 0; i < periods.size() * kRealsPerPeriod; ++i) expected.body()[i] = arena.body(3)[i];
   expected.mutable_header() = arena.header(3);
-  wide.Fold(3, arena.header(3), arena.body(3), phasors, 1.0f);
+  wide.Fold(3, arena.header(3), arena.body(3), table, 1.0f);
   expected.Observe(phasors, 1.0f);
   EXPECT_EQ(arena.header(3), expected.header());
   for (size_t i = 0; i < periods.size() * kRealsPerPeriod; ++i) {
     EXPECT_EQ(arena.body(3)[i], static_cast<float>(expected.body()[i])) << i;
+  }
+}
+
+TEST(WideBodiesTest, FoldIsFoldObservationWithTheTablesPhasorsBitForBit) {
+  // Fold reads the table's cos and sin instead of ScanPhasors<double>; a record's bits must not
+  // depend on which one folded it (recovery and a recomputation compare them exactly).
+  const PeriodSet periods = PeriodSet::Default();
+  const size_t reals = periods.size() * kRealsPerPeriod;
+  RecordArena arena(periods.size(), 1);
+  WideBodies wide(periods.size());
+  wide.Widen(0, arena.body(0));
+  BasicSpectrum<double> expected(periods.size());
+  const float values[] = {1.0f, 0.0f, 0.3f, 1.0f, 0.75f};
+  for (size_t i = 0; i < 5000; ++i) {
+    const PhasorTable table(periods, 1.7e9 + 37.1 * static_cast<double>(i) * static_cast<double>(i % 13));
+    const float s = values[i % 5];
+    wide.Fold(0, arena.header(0), arena.body(0), table, s);
+    expected.Observe(ScanPhasors<double>(table), s);
+  }
+  EXPECT_EQ(arena.header(0), expected.header());
+  const std::string encoded = wide.Encode(0);
+  ASSERT_EQ(encoded.size(), 1 + reals * sizeof(double));
+  for (size_t i = 0; i < reals; ++i) {
+    double folded;
+    std::memcpy(&folded, encoded.data() + 1 + i * sizeof(double), sizeof(double));  // little-endian host
+    EXPECT_EQ(std::bit_cast<uint64_t>(folded), std::bit_cast<uint64_t>(expected.body()[i])) << i;
   }
 }
 
