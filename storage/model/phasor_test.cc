@@ -32,7 +32,7 @@ TEST(PeriodSetTest, HarmonicOnlyWhenEveryPeriodIsTheFirstOverItsIndex) {
   EXPECT_TRUE(PeriodSet::FromPeriods({86400, 43200, 28800})->harmonic());
   EXPECT_FALSE(PeriodSet::FromPeriods({86400, 3600})->harmonic());
   EXPECT_FALSE(PeriodSet::FromPeriods({86400, 28800, 43200})->harmonic());
-  // Whole seconds: 604800/7 is not a whole number of seconds... but 604800/9 is not either.
+  // Periods floored to whole seconds are not exact harmonics past k = 10 (604800/11 → 54981 s).
   EXPECT_FALSE(PeriodSet::Harmonics(604800, 24, true)->harmonic());
 }
 

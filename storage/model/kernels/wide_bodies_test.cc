@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <string>
-#include <cmath>
 #include <vector>
 
 #include "storage/model/periods.h"
