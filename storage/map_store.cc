@@ -236,6 +236,7 @@ absl::Status MapStoreImpl::Recover() {
   wal_options.segment_bytes = options_.log_segment_bytes;
   wal_options.env = options_.env;
   wal_options.min_next_lsn = newest + 1;
+  wal_options.replayed = &*replayed;
   auto wal = WalWriter::Open(dir_ + "/wal", wal_options);
   if (!wal.ok()) return wal.status();
   wal_ = *std::move(wal);

@@ -203,6 +203,11 @@ absl::StatusOr<WalReplayResult> ReplayWal(const std::string& dir, uint64_t after
     }
     if (!scan.ok()) return scan.status();
     if (scan->end == SegmentScan::End::kCorrupt) return absl::DataLossError(scan->damage);
+    if (last) {
+      result.newest_segment_scanned = true;
+      result.newest_segment_first = first;
+      result.newest_segment_intact_bytes = scan->intact_bytes;
+    }
     if (scan->end == SegmentScan::End::kTornTail) {
       if (!last) {
         return absl::DataLossError(absl::StrCat("write-ahead log ", path, ": record at byte ", scan->intact_bytes,
@@ -242,22 +247,31 @@ absl::StatusOr<std::unique_ptr<WalWriter>> WalWriter::Open(const std::string& di
   // are covered by the checkpoint anyway.
   const uint64_t last_first = firsts->back();
   const std::string last_path = SegmentPath(dir, last_first);
-  auto data = env->ReadFile(last_path);
-  if (!data.ok()) return data.status();
   uint64_t expected = last_first;
-  uint64_t ignored = 0;
-  uint64_t ignored_position = 0;
-  auto scan = ScanSegment(last_path, Bytes(*data), expected, UINT64_MAX, nullptr, ignored, ignored_position);
-  if (!scan.ok()) return scan.status();
-  if (scan->end == SegmentScan::End::kCorrupt) return absl::DataLossError(scan->damage);
-  if (scan->end == SegmentScan::End::kTornTail) {
-    if (absl::Status s = env->Truncate(last_path, scan->intact_bytes); !s.ok()) return s;
+  uint64_t intact_bytes = 0;
+  if (const WalReplayResult* replayed = options.replayed;
+      replayed != nullptr && replayed->newest_segment_scanned && replayed->newest_segment_first == last_first) {
+    // The replay read this segment a moment ago and stopped at its last intact record.
+    expected = replayed->last_lsn + 1;
+    intact_bytes = replayed->newest_segment_intact_bytes;
+  } else {
+    auto data = env->ReadFile(last_path);
+    if (!data.ok()) return data.status();
+    uint64_t ignored = 0;
+    uint64_t ignored_position = 0;
+    auto scan = ScanSegment(last_path, Bytes(*data), expected, UINT64_MAX, nullptr, ignored, ignored_position);
+    if (!scan.ok()) return scan.status();
+    if (scan->end == SegmentScan::End::kCorrupt) return absl::DataLossError(scan->damage);
+    intact_bytes = scan->intact_bytes;
   }
-  writer->segments_.back().bytes = scan->intact_bytes;
+  if (intact_bytes < writer->segments_.back().bytes) {  // a torn tail
+    if (absl::Status s = env->Truncate(last_path, intact_bytes); !s.ok()) return s;
+  }
+  writer->segments_.back().bytes = intact_bytes;
   auto file = env->NewAppendableFile(last_path);
   if (!file.ok()) return file.status();
   writer->file_ = *std::move(file);
-  writer->segment_size_ = scan->intact_bytes;
+  writer->segment_size_ = intact_bytes;
   writer->next_lsn_ = expected;
   for (const Segment& s : writer->segments_) writer->bytes_ += s.bytes;
   if (writer->next_lsn_ < floor) {

@@ -35,6 +35,8 @@
 
 namespace fremen::storage {
 
+struct WalReplayResult;
+
 struct WalOptions {
   // A new segment starts once the current one passes this size; checkpoints delete whole
   // segments, so smaller segments free space sooner at the cost of more files. Default: 64 MiB.
@@ -47,6 +49,12 @@ struct WalOptions {
   // it as checkpointed). When the log ends below it, a new segment starts at the floor.
   // Default: 1.
   uint64_t min_next_lsn = 1;
+  // The replay of this log that came just before (a recovery's), or null. Its scan of the newest
+  // segment stands in for the writer's own when it names the same segment: the writer then cuts
+  // the torn tail the replay found instead of reading and checking the segment a second time (up
+  // to a segment's size, tens of MB, of a recovery's reading). Nothing may write the log between
+  // the replay and the writer's Open.
+  const WalReplayResult* replayed = nullptr;
 };
 
 struct WalReplayResult {
@@ -57,6 +65,12 @@ struct WalReplayResult {
   std::string torn_tail_file;
   uint64_t torn_tail_offset = 0;
   uint64_t torn_tail_bytes = 0;
+  // The newest segment, as the replay found it (always read, even when a checkpoint covers it):
+  // its first LSN and the length of its prefix of intact records in sequence. For WalWriter::Open
+  // (WalOptions::replayed). newest_segment_scanned is false when the log had no segment.
+  bool newest_segment_scanned = false;
+  uint64_t newest_segment_first = 0;
+  uint64_t newest_segment_intact_bytes = 0;
 };
 
 // Where a replay that failed stopped: the first record it did not replay (damaged, out of sequence,

@@ -97,6 +97,74 @@ TEST(WalTest, ATornTailIsCutAndTheLogGoesOn) {
   EXPECT_FALSE(result.truncated_tail);
 }
 
+TEST(WalTest, AWriterOpenedAfterItsReplayTakesTheNewestSegmentFromItAndCutsTheTornTail) {
+  fremen::testing::TempDir dir;
+  WalOptions small;
+  small.segment_bytes = 2000;  // several segments: the replay's newest one is what the writer uses
+  {
+    auto wal = WalWriter::Open(dir.path(), small);
+    ASSERT_TRUE(wal.ok());
+    for (uint64_t i = 1; i <= 60; ++i) {
+      (*wal)->Append(Payload(i));
+      ASSERT_TRUE((*wal)->Sync().ok());
+    }
+  }
+  std::string newest;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path())) newest = std::max(newest, e.path().string());
+  const auto size = std::filesystem::file_size(newest);
+  std::filesystem::resize_file(newest, size - 3);  // the last record loses its end
+  WalReplayResult replayed;
+  ASSERT_EQ(ReplayAll(dir.path(), 0, &replayed).size(), 59u);
+  ASSERT_TRUE(replayed.newest_segment_scanned);
+  EXPECT_EQ(replayed.newest_segment_intact_bytes, size - (16 + Payload(60).size()));
+  // Damage the newest segment's first byte after the replay: a writer that read the segment again
+  // would find corruption; one that takes the replay's scan opens where the replay stopped.
+  {
+    std::fstream f(newest, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(20);
+    f.put('\x5a');
+  }
+  WalOptions options = small;
+  options.replayed = &replayed;
+  auto wal = WalWriter::Open(dir.path(), options);
+  ASSERT_TRUE(wal.ok()) << wal.status();
+  EXPECT_EQ(std::filesystem::file_size(newest), replayed.newest_segment_intact_bytes);  // the tail is cut
+  EXPECT_EQ((*wal)->Append(Payload(60)), 60u);
+  ASSERT_TRUE((*wal)->Sync().ok());
+  // Without the replay's scan the writer reads the segment itself and finds the damage.
+  wal->reset();
+  EXPECT_EQ(WalWriter::Open(dir.path(), small).status().code(), absl::StatusCode::kDataLoss);
+}
+
+TEST(WalTest, AReplayOfAnotherNewestSegmentIsNotTakenByTheWriter) {
+  fremen::testing::TempDir dir;
+  WalOptions small;
+  small.segment_bytes = 2000;
+  {
+    auto wal = WalWriter::Open(dir.path(), small);
+    ASSERT_TRUE(wal.ok());
+    for (uint64_t i = 1; i <= 10; ++i) (*wal)->Append(Payload(i));
+    ASSERT_TRUE((*wal)->Sync().ok());
+  }
+  WalReplayResult stale;
+  ASSERT_EQ(ReplayAll(dir.path(), 0, &stale).size(), 10u);
+  {
+    auto wal = WalWriter::Open(dir.path(), small);
+    ASSERT_TRUE(wal.ok());
+    for (uint64_t i = 11; i <= 60; ++i) {
+      (*wal)->Append(Payload(i));
+      ASSERT_TRUE((*wal)->Sync().ok());  // rolls into new segments
+    }
+  }
+  WalOptions options = small;
+  options.replayed = &stale;  // names a segment that is no longer the newest
+  auto wal = WalWriter::Open(dir.path(), options);
+  ASSERT_TRUE(wal.ok()) << wal.status();
+  EXPECT_EQ((*wal)->Append(Payload(61)), 61u);
+  ASSERT_TRUE((*wal)->Sync().ok());
+  EXPECT_EQ(ReplayAll(dir.path(), 0).size(), 61u);
+}
+
 TEST(WalTest, SegmentsRollAndCheckpointedOnesAreDropped) {
   fremen::testing::TempDir dir;
   WalOptions options;
