@@ -427,43 +427,55 @@ void Shard::ObservedKeys(std::span<const uint64_t> keys, std::span<const uint32_
   }
 }
 
-template <typename Visit, typename EndBrick>
-void Shard::ForEachBoxCell(const CellBox& box, Visit visit, EndBrick end_brick) const {
-  const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
-  const std::array<uint32_t, 3> bs = grid_keys_.brick_size();
-  // A cell's index in its brick is its key's low 9 bits: the sum of each axis' bits, spread —
-  // three lookups per cell instead of a Morton encoding.
-  std::array<uint32_t, 32> spread_x{}, spread_y{}, spread_z{};
-  const uint32_t mask_x = bs[0] - 1;  // brick sides are powers of two
+Shard::BoxWalk Shard::WalkOf(const CellBox& box) const {
+  BoxWalk walk;
+  const std::array<uint32_t, 3> bs = walk.brick_size = grid_keys_.brick_size();
   for (uint32_t i = 0; i < 32; ++i) {
-    if (i < bs[0]) spread_x[i] = grid_keys_.LocalIndex(i, 0, 0);
-    if (i < bs[1]) spread_y[i] = grid_keys_.LocalIndex(0, i, 0);
-    if (i < bs[2]) spread_z[i] = grid_keys_.LocalIndex(0, 0, i);
+    if (i < bs[0]) walk.spread_x[i] = grid_keys_.LocalIndex(i, 0, 0);
+    if (i < bs[1]) walk.spread_y[i] = grid_keys_.LocalIndex(0, i, 0);
+    if (i < bs[2]) walk.spread_z[i] = grid_keys_.LocalIndex(0, 0, i);
   }
-  // Brick by brick: one hash lookup per brick, then the cells of the box inside it.
+  // One hash lookup per brick.
   for (uint32_t bz = box.lo[2] / bs[2]; bz <= (box.hi[2] - 1) / bs[2]; ++bz) {
     for (uint32_t by = box.lo[1] / bs[1]; by <= (box.hi[1] - 1) / bs[1]; ++by) {
       for (uint32_t bx = box.lo[0] / bs[0]; bx <= (box.hi[0] - 1) / bs[0]; ++bx) {
         const auto it = bricks_.find(BrickOf(grid_keys_.Key(bx * bs[0], by * bs[1], bz * bs[2])));
-        if (it == bricks_.end()) continue;
-        const Brick& brick = brick_data_[it->second];
-        const uint32_t z0 = std::max(box.lo[2], bz * bs[2]), z1 = std::min(box.hi[2], (bz + 1) * bs[2]);
-        const uint32_t y0 = std::max(box.lo[1], by * bs[1]), y1 = std::min(box.hi[1], (by + 1) * bs[1]);
-        const uint32_t x0 = std::max(box.lo[0], bx * bs[0]), x1 = std::min(box.hi[0], (bx + 1) * bs[0]);
-        for (uint32_t z = z0; z < z1; ++z) {
-          for (uint32_t y = y0; y < y1; ++y) {
-            // The index of cell (0, y, z) in the box (x = lo.x is at row + lo.x).
-            const uint64_t row = ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
-            const uint32_t yz = spread_y[y & (bs[1] - 1)] | spread_z[z & (bs[2] - 1)];
-            for (uint32_t x = x0; x < x1; ++x) {
-              const uint32_t handle = brick.handles[yz | spread_x[x & mask_x]];
-              if (handle != kNone) visit(handle, row + x);
-            }
-          }
-        }
-        end_brick();
+        if (it != bricks_.end()) walk.bricks.push_back({&brick_data_[it->second], bx, by, bz});
       }
     }
+  }
+  walk.PrefetchHandles(0);
+  return walk;
+}
+
+void Shard::BoxWalk::PrefetchHandles(size_t b) const {
+  if (b < bricks.size()) model::PrefetchForRead(bricks[b].brick->handles.data(), sizeof(Brick::handles));
+}
+
+template <typename Visit, typename EndBrick>
+void Shard::ForEachBoxCell(const CellBox& box, Visit visit, EndBrick end_brick) const {
+  const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
+  const BoxWalk walk = WalkOf(box);
+  const std::array<uint32_t, 3> bs = walk.brick_size;
+  const uint32_t mask_x = bs[0] - 1;  // brick sides are powers of two
+  for (size_t b = 0; b < walk.bricks.size(); ++b) {
+    walk.PrefetchHandles(b + 1);
+    const auto [brick, bx, by, bz] = walk.bricks[b];
+    const uint32_t z0 = std::max(box.lo[2], bz * bs[2]), z1 = std::min(box.hi[2], (bz + 1) * bs[2]);
+    const uint32_t y0 = std::max(box.lo[1], by * bs[1]), y1 = std::min(box.hi[1], (by + 1) * bs[1]);
+    const uint32_t x0 = std::max(box.lo[0], bx * bs[0]), x1 = std::min(box.hi[0], (bx + 1) * bs[0]);
+    for (uint32_t z = z0; z < z1; ++z) {
+      for (uint32_t y = y0; y < y1; ++y) {
+        // The index of cell (0, y, z) in the box (x = lo.x is at row + lo.x).
+        const uint64_t row = ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
+        const uint32_t yz = walk.spread_y[y & (bs[1] - 1)] | walk.spread_z[z & (bs[2] - 1)];
+        for (uint32_t x = x0; x < x1; ++x) {
+          const uint32_t handle = brick->handles[yz | walk.spread_x[x & mask_x]];
+          if (handle != kNone) visit(handle, row + x);
+        }
+      }
+    }
+    end_brick();
   }
 }
 
@@ -541,52 +553,53 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   if (box.cell_count() == 0) return;
   base::ReaderMutexLock lock(&mutex_);
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
-  const std::array<uint32_t, 3> bs = grid_keys_.brick_size();
-  // A cell's index in its brick is its key's low 9 bits: the sum of each axis' bits, spread —
-  // three lookups per cell instead of a Morton encoding.
-  std::array<uint32_t, 32> spread_x{}, spread_y{}, spread_z{};
+  const BoxWalk walk = WalkOf(box);
+  const std::array<uint32_t, 3> bs = walk.brick_size;
   const uint32_t mask_x = bs[0] - 1;  // brick sides are powers of two
-  for (uint32_t i = 0; i < 32; ++i) {
-    if (i < bs[0]) spread_x[i] = grid_keys_.LocalIndex(i, 0, 0);
-    if (i < bs[1]) spread_y[i] = grid_keys_.LocalIndex(0, i, 0);
-    if (i < bs[2]) spread_z[i] = grid_keys_.LocalIndex(0, 0, i);
-  }
-  // Brick by brick: one hash lookup per brick, then the cells of the box inside it. The cells whose
-  // state has a published model — nearly all, on a map in use — go through the region kernel
-  // together, a brick at a time; the others are answered one by one.
-  std::array<uint32_t, 512> published;
-  std::array<float*, 512> published_cells;
+  // The cells whose state has a published model — nearly all dynamic ones, on a map in use — go
+  // through the region kernel together, a brick at a time; the others are answered one by one.
+  // Whether a state is published is in its model record, which is cold: the brick's dynamic
+  // states are gathered first with their records prefetched, and told apart once those are on
+  // their way (a miss per dynamic cell, one after another, and one per line of a brick's handles
+  // were most of a 1M-cell region's samples).
+  std::array<uint32_t, 512> dynamic, published;
+  std::array<float*, 512> dynamic_cells, published_cells;
   std::array<float, 512> predicted;
-  for (uint32_t bz = box.lo[2] / bs[2]; bz <= (box.hi[2] - 1) / bs[2]; ++bz) {
-    for (uint32_t by = box.lo[1] / bs[1]; by <= (box.hi[1] - 1) / bs[1]; ++by) {
-      for (uint32_t bx = box.lo[0] / bs[0]; bx <= (box.hi[0] - 1) / bs[0]; ++bx) {
-        const auto it = bricks_.find(BrickOf(grid_keys_.Key(bx * bs[0], by * bs[1], bz * bs[2])));
-        if (it == bricks_.end()) continue;
-        const Brick& brick = brick_data_[it->second];
-        const uint32_t z0 = std::max(box.lo[2], bz * bs[2]), z1 = std::min(box.hi[2], (bz + 1) * bs[2]);
-        const uint32_t y0 = std::max(box.lo[1], by * bs[1]), y1 = std::min(box.hi[1], (by + 1) * bs[1]);
-        const uint32_t x0 = std::max(box.lo[0], bx * bs[0]), x1 = std::min(box.hi[0], (bx + 1) * bs[0]);
-        size_t n = 0;
-        for (uint32_t z = z0; z < z1; ++z) {
-          for (uint32_t y = y0; y < y1; ++y) {
-            float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
-            const uint32_t yz = spread_y[y & (bs[1] - 1)] | spread_z[z & (bs[2] - 1)];
-            for (uint32_t x = x0; x < x1; ++x) {
-              const uint32_t handle = brick.handles[yz | spread_x[x & mask_x]];
-              if (handle == kNone) continue;
-              if (!(handle & kStaticHandle) && models_.published(handle)) {
-                published[n] = handle;
-                published_cells[n++] = &row[x];
-              } else {
-                row[x] = PredictHandle(handle, table, options);
-              }
-            }
+  for (size_t b = 0; b < walk.bricks.size(); ++b) {
+    walk.PrefetchHandles(b + 1);
+    const auto [brick, bx, by, bz] = walk.bricks[b];
+    const uint32_t z0 = std::max(box.lo[2], bz * bs[2]), z1 = std::min(box.hi[2], (bz + 1) * bs[2]);
+    const uint32_t y0 = std::max(box.lo[1], by * bs[1]), y1 = std::min(box.hi[1], (by + 1) * bs[1]);
+    const uint32_t x0 = std::max(box.lo[0], bx * bs[0]), x1 = std::min(box.hi[0], (bx + 1) * bs[0]);
+    size_t m = 0;
+    for (uint32_t z = z0; z < z1; ++z) {
+      for (uint32_t y = y0; y < y1; ++y) {
+        float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
+        const uint32_t yz = walk.spread_y[y & (bs[1] - 1)] | walk.spread_z[z & (bs[2] - 1)];
+        for (uint32_t x = x0; x < x1; ++x) {
+          const uint32_t handle = brick->handles[yz | walk.spread_x[x & mask_x]];
+          if (handle == kNone) continue;
+          if (handle & kStaticHandle) {
+            row[x] = PredictHandle(handle, table, options);
+          } else {
+            __builtin_prefetch(models_.record(handle));
+            dynamic[m] = handle;
+            dynamic_cells[m++] = &row[x];
           }
         }
-        PredictPublished({published.data(), n}, table, options, predicted.data());
-        for (size_t i = 0; i < n; ++i) *published_cells[i] = predicted[i];
       }
     }
+    size_t n = 0;
+    for (size_t i = 0; i < m; ++i) {
+      if (models_.published(dynamic[i])) {
+        published[n] = dynamic[i];
+        published_cells[n++] = dynamic_cells[i];
+      } else {
+        *dynamic_cells[i] = PredictHandle(dynamic[i], table, options);
+      }
+    }
+    PredictPublished({published.data(), n}, table, options, predicted.data());
+    for (size_t i = 0; i < n; ++i) *published_cells[i] = predicted[i];
   }
 }
 

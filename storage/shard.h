@@ -220,6 +220,21 @@ class Shard {
   // models through the region kernel together, the others one by one.
   void PredictHandles(std::span<const uint32_t> handles, const uint32_t* at, const model::PhasorTable& table,
                       const PredictOptions& options, float* out) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  // A box walked brick by brick (ForEachBoxCell, PredictBox): this shard's bricks in the box, in
+  // the box's order, and a cell's index in its brick as the sum of its axes' bits, spread (three
+  // lookups per cell instead of a Morton encoding).
+  struct BoxWalk {
+    struct BoxBrick {
+      const Brick* brick;
+      uint32_t bx, by, bz;
+    };
+    std::array<uint32_t, 3> brick_size;
+    std::array<uint32_t, 32> spread_x{}, spread_y{}, spread_z{};
+    std::vector<BoxBrick> bricks;
+    // A brick's handles (2 KB) are cold: the walk fetches the next brick's while it visits one.
+    void PrefetchHandles(size_t b) const;
+  };
+  BoxWalk WalkOf(const CellBox& box) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // Calls visit(handle, index in the box) for every cell of `box` held by this shard, brick by
   // brick, and end_brick() after each brick's cells.
   template <typename Visit, typename EndBrick>
