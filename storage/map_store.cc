@@ -996,8 +996,19 @@ absl::Status MapStoreImpl::CheckBox(const CellBox& box) const {
 absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
                                   std::vector<float>& out) const {
   if (absl::Status s = CheckBox(box); !s.ok()) return s;
+  out.resize(box.cell_count());
+  return PredictBox(box, t, options, std::span<float>(out));
+}
+
+absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
+                                  std::span<float> out) const {
+  if (absl::Status s = CheckBox(box); !s.ok()) return s;
+  if (out.size() != box.cell_count()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("out holds ", out.size(), " values for a box of ", box.cell_count(), " cells"));
+  }
   const model::PhasorTable table(settings_->periods, t);
-  out.assign(box.cell_count(), kUnobservedProbability);
+  std::fill(out.begin(), out.end(), kUnobservedProbability);
   ParallelForShards(
       shards_.size(), [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); },
       /*parallel=*/box.cell_count() >= (1u << 16));

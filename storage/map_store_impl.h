@@ -59,6 +59,8 @@ class MapStoreImpl final : public MapStore {
                              const PredictOptions& options) const override;
   absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
                           std::vector<float>& out) const override;
+  absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
+                          std::span<float> out) const override;
   absl::StatusOr<BoxSeries> PlanBoxSeries(const CellBox& box, double t, const PredictOptions& options) const override;
   void PredictBoxSeries(const BoxSeries& plan, double t, std::vector<float>& out) const override;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const override;

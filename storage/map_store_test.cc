@@ -211,6 +211,15 @@ TEST(MapStoreTest, PredictionsMatchTheModelsAndRegionsMatchPoints) {
   std::vector<float> out;
   EXPECT_TRUE(absl::IsOutOfRange(store->PredictBox({{0, 0, 0}, {41, 1, 1}}, t, {}, out)));
   EXPECT_TRUE(absl::IsOutOfRange(store->PredictBox({{5, 0, 0}, {5, 1, 1}}, t, {}, out)));
+  // Into the caller's memory (a response's values): the same p, every value written (the memory's
+  // old contents are not 0.5 or any p), and only into memory of the box's size.
+  std::vector<float> in_place(box.cell_count(), -1.0f);
+  ASSERT_TRUE(store->PredictBox(box, t, {}, std::span<float>(in_place)).ok());
+  EXPECT_EQ(in_place, region);
+  std::vector<float> short_by_one(box.cell_count() - 1);
+  const absl::Status wrong_size = store->PredictBox(box, t, {}, std::span<float>(short_by_one));
+  EXPECT_TRUE(absl::IsInvalidArgument(wrong_size)) << wrong_size;
+  EXPECT_NE(wrong_size.message().find("out holds"), std::string::npos) << wrong_size;
 }
 
 // A box query and a point query answer a published state by the region kernel the benchmark measures

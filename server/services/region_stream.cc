@@ -45,16 +45,33 @@ bool RegionStream::ComputesInline(uint64_t i) const {
 
 absl::Status RegionStream::ComputeBlock(uint64_t i, Chunks& chunks, uint64_t& /*more_blocks*/) {
   const RegionPlan::Chunk block = blocks_->chunk(i);
-  if (absl::Status s = map_->PredictBox(block.box, time_, options_, scratch_); !s.ok()) return s;
   // A block is a run of the box's cells in the box's order, and so is each chunk of the block.
   const RegionPlan plan(block.box, chunk_cells_);
+  const bool floats = output_ == v1::REGION_OUTPUT_FLOAT;
+  // Floats are predicted straight into each chunk's response; the other outputs are computed from
+  // the block's p, predicted once into scratch_.
+  if (!floats) {
+    if (absl::Status s = map_->PredictBox(block.box, time_, options_, scratch_); !s.ok()) return s;
+  }
   for (uint64_t j = 0; j < plan.chunk_count(); ++j) {
     const RegionPlan::Chunk chunk = plan.chunk(j);
     std::unique_ptr<Response> buffer = TakeBuffer();
     buffer->set_offset(block.offset + chunk.offset);
     buffer->set_box_cells(blocks_->box_cells());
-    EncodeRegionValues(output_, confidence_,
-                       std::span<const float>(scratch_).subspan(chunk.offset, chunk.box.cell_count()), *buffer);
+    if (floats) {
+      // Room for the chunk's values, written once, by the prediction (a buffer keeps its capacity).
+      google::protobuf::RepeatedField<float>& values = *buffer->mutable_float_values();
+      values.Clear();
+      values.Reserve(static_cast<int>(chunk.box.cell_count()));
+      float* out = values.AddNAlreadyReserved(static_cast<int>(chunk.box.cell_count()));
+      if (absl::Status s = map_->PredictBox(chunk.box, time_, options_, {out, chunk.box.cell_count()}); !s.ok()) {
+        return s;
+      }
+      buffer->clear_bytes_values();
+    } else {
+      EncodeRegionValues(output_, confidence_,
+                         std::span<const float>(scratch_).subspan(chunk.offset, chunk.box.cell_count()), *buffer);
+    }
     chunks.push_back(std::move(buffer));
   }
   return absl::OkStatus();

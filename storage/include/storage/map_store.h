@@ -231,6 +231,10 @@ class MapStore {
   // p(t) of every cell of a box of a grid, x fastest; unobserved cells 0.5.
   virtual absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
                                   std::vector<float>& out) const = 0;
+  // The same into memory of the caller's (a response's values, written in place): InvalidArgument
+  // unless out holds exactly the box's cells.
+  virtual absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
+                                  std::span<float> out) const = 0;
   // A box at many times, planned once at `t` (one of the times): which cells vary with time and
   // the others' p. Errors as PredictBox's. The plan holds the models as they are now: a later
   // batch that makes a constant cell vary is not seen by it.
