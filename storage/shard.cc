@@ -452,6 +452,16 @@ void Shard::BoxWalk::PrefetchHandles(size_t b) const {
   if (b < bricks.size()) model::PrefetchForRead(bricks[b].brick->handles.data(), sizeof(Brick::handles));
 }
 
+Shard::BoxWalk::Cells Shard::BoxWalk::CellsIn(const CellBox& box, size_t b) const {
+  const std::array<uint32_t, 3> at = {bricks[b].bx, bricks[b].by, bricks[b].bz};
+  Cells cells;
+  for (int a = 0; a < 3; ++a) {
+    cells.lo[a] = std::max(box.lo[a], at[a] * brick_size[a]);
+    cells.hi[a] = std::min(box.hi[a], (at[a] + 1) * brick_size[a]);
+  }
+  return cells;
+}
+
 template <typename Visit, typename EndBrick>
 void Shard::ForEachBoxCell(const CellBox& box, Visit visit, EndBrick end_brick) const {
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
@@ -460,16 +470,14 @@ void Shard::ForEachBoxCell(const CellBox& box, Visit visit, EndBrick end_brick) 
   const uint32_t mask_x = bs[0] - 1;  // brick sides are powers of two
   for (size_t b = 0; b < walk.bricks.size(); ++b) {
     walk.PrefetchHandles(b + 1);
-    const auto [brick, bx, by, bz] = walk.bricks[b];
-    const uint32_t z0 = std::max(box.lo[2], bz * bs[2]), z1 = std::min(box.hi[2], (bz + 1) * bs[2]);
-    const uint32_t y0 = std::max(box.lo[1], by * bs[1]), y1 = std::min(box.hi[1], (by + 1) * bs[1]);
-    const uint32_t x0 = std::max(box.lo[0], bx * bs[0]), x1 = std::min(box.hi[0], (bx + 1) * bs[0]);
-    for (uint32_t z = z0; z < z1; ++z) {
-      for (uint32_t y = y0; y < y1; ++y) {
+    const Brick* brick = walk.bricks[b].brick;
+    const BoxWalk::Cells c = walk.CellsIn(box, b);
+    for (uint32_t z = c.lo[2]; z < c.hi[2]; ++z) {
+      for (uint32_t y = c.lo[1]; y < c.hi[1]; ++y) {
         // The index of cell (0, y, z) in the box (x = lo.x is at row + lo.x).
         const uint64_t row = ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
         const uint32_t yz = walk.spread_y[y & (bs[1] - 1)] | walk.spread_z[z & (bs[2] - 1)];
-        for (uint32_t x = x0; x < x1; ++x) {
+        for (uint32_t x = c.lo[0]; x < c.hi[0]; ++x) {
           const uint32_t handle = brick->handles[yz | walk.spread_x[x & mask_x]];
           if (handle != kNone) visit(handle, row + x);
         }
@@ -567,16 +575,14 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   std::array<float, 512> predicted;
   for (size_t b = 0; b < walk.bricks.size(); ++b) {
     walk.PrefetchHandles(b + 1);
-    const auto [brick, bx, by, bz] = walk.bricks[b];
-    const uint32_t z0 = std::max(box.lo[2], bz * bs[2]), z1 = std::min(box.hi[2], (bz + 1) * bs[2]);
-    const uint32_t y0 = std::max(box.lo[1], by * bs[1]), y1 = std::min(box.hi[1], (by + 1) * bs[1]);
-    const uint32_t x0 = std::max(box.lo[0], bx * bs[0]), x1 = std::min(box.hi[0], (bx + 1) * bs[0]);
+    const Brick* brick = walk.bricks[b].brick;
+    const BoxWalk::Cells c = walk.CellsIn(box, b);
     size_t m = 0;
-    for (uint32_t z = z0; z < z1; ++z) {
-      for (uint32_t y = y0; y < y1; ++y) {
+    for (uint32_t z = c.lo[2]; z < c.hi[2]; ++z) {
+      for (uint32_t y = c.lo[1]; y < c.hi[1]; ++y) {
         float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
         const uint32_t yz = walk.spread_y[y & (bs[1] - 1)] | walk.spread_z[z & (bs[2] - 1)];
-        for (uint32_t x = x0; x < x1; ++x) {
+        for (uint32_t x = c.lo[0]; x < c.hi[0]; ++x) {
           const uint32_t handle = brick->handles[yz | walk.spread_x[x & mask_x]];
           if (handle == kNone) continue;
           if (handle & kStaticHandle) {

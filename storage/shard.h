@@ -233,6 +233,11 @@ class Shard {
     std::vector<BoxBrick> bricks;
     // A brick's handles (2 KB) are cold: the walk fetches the next brick's while it visits one.
     void PrefetchHandles(size_t b) const;
+    // The cells of `box` in brick b: [lo[a], hi[a]) on each axis a.
+    struct Cells {
+      std::array<uint32_t, 3> lo, hi;
+    };
+    Cells CellsIn(const CellBox& box, size_t b) const;
   };
   BoxWalk WalkOf(const CellBox& box) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // Calls visit(handle, index in the box) for every cell of `box` held by this shard, brick by

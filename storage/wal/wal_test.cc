@@ -33,6 +33,16 @@ std::vector<uint64_t> ReplayAll(const std::string& dir, uint64_t after, WalRepla
   return lsns;
 }
 
+// Appends records first..last, each synced (so that segments roll at options.segment_bytes).
+void AppendSynced(const std::string& dir, const WalOptions& options, uint64_t first, uint64_t last) {
+  auto wal = WalWriter::Open(dir, options);
+  ASSERT_TRUE(wal.ok()) << wal.status();
+  for (uint64_t i = first; i <= last; ++i) {
+    ASSERT_EQ((*wal)->Append(Payload(i)), i);
+    ASSERT_TRUE((*wal)->Sync().ok());
+  }
+}
+
 TEST(WalTest, ReplaysWhatWasSyncedInOrderAfterAGivenLsn) {
   fremen::testing::TempDir dir;
   {
@@ -101,14 +111,7 @@ TEST(WalTest, AWriterOpenedAfterItsReplayTakesTheNewestSegmentFromItAndCutsTheTo
   fremen::testing::TempDir dir;
   WalOptions small;
   small.segment_bytes = 2000;  // several segments: the replay's newest one is what the writer uses
-  {
-    auto wal = WalWriter::Open(dir.path(), small);
-    ASSERT_TRUE(wal.ok());
-    for (uint64_t i = 1; i <= 60; ++i) {
-      (*wal)->Append(Payload(i));
-      ASSERT_TRUE((*wal)->Sync().ok());
-    }
-  }
+  AppendSynced(dir.path(), small, 1, 60);
   std::string newest;
   for (const auto& e : std::filesystem::directory_iterator(dir.path())) newest = std::max(newest, e.path().string());
   const auto size = std::filesystem::file_size(newest);
@@ -117,7 +120,7 @@ TEST(WalTest, AWriterOpenedAfterItsReplayTakesTheNewestSegmentFromItAndCutsTheTo
   ASSERT_EQ(ReplayAll(dir.path(), 0, &replayed).size(), 59u);
   ASSERT_TRUE(replayed.newest_segment_scanned);
   EXPECT_EQ(replayed.newest_segment_intact_bytes, size - (16 + Payload(60).size()));
-  // Damage the newest segment's first byte after the replay: a writer that read the segment again
+  // Damage the newest segment's first record after the replay: a writer that read the segment again
   // would find corruption; one that takes the replay's scan opens where the replay stopped.
   {
     std::fstream f(newest, std::ios::in | std::ios::out | std::ios::binary);
@@ -140,22 +143,11 @@ TEST(WalTest, AReplayOfAnotherNewestSegmentIsNotTakenByTheWriter) {
   fremen::testing::TempDir dir;
   WalOptions small;
   small.segment_bytes = 2000;
-  {
-    auto wal = WalWriter::Open(dir.path(), small);
-    ASSERT_TRUE(wal.ok());
-    for (uint64_t i = 1; i <= 10; ++i) (*wal)->Append(Payload(i));
-    ASSERT_TRUE((*wal)->Sync().ok());
-  }
+  AppendSynced(dir.path(), small, 1, 10);
   WalReplayResult stale;
   ASSERT_EQ(ReplayAll(dir.path(), 0, &stale).size(), 10u);
-  {
-    auto wal = WalWriter::Open(dir.path(), small);
-    ASSERT_TRUE(wal.ok());
-    for (uint64_t i = 11; i <= 60; ++i) {
-      (*wal)->Append(Payload(i));
-      ASSERT_TRUE((*wal)->Sync().ok());  // rolls into new segments
-    }
-  }
+  AppendSynced(dir.path(), small, 11, 60);  // rolls into new segments
+  ASSERT_TRUE(stale.newest_segment_scanned);
   WalOptions options = small;
   options.replayed = &stale;  // names a segment that is no longer the newest
   auto wal = WalWriter::Open(dir.path(), options);
