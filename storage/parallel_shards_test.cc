@@ -3,9 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <chrono>
 #include <thread>
 #include <vector>
+
+#include "storage/testing/start_barrier.h"
 
 namespace fremen::storage {
 namespace {
@@ -21,16 +22,11 @@ TEST(ParallelForShardsTest, RunsEveryShardExactlyOnce) {
 }
 
 TEST(ParallelForShardsTest, InParallelEveryShardRunsAtOnceAndSerialOnTheCaller) {
-  // Each shard waits until all have started (or gives up after a minute, so that running them one
-  // after another fails rather than hangs): every one sees all started only if they run at once.
+  // Every shard sees all started only if they run at once.
   constexpr size_t kShards = 4;
-  std::atomic<size_t> started = 0, saw_all = 0;
-  ParallelForShards(kShards, [&](size_t) {
-    ++started;
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(1);
-    while (started < kShards && std::chrono::steady_clock::now() < give_up) std::this_thread::yield();
-    if (started == kShards) ++saw_all;
-  });
+  testing::StartBarrier barrier(kShards);
+  std::atomic<size_t> saw_all = 0;
+  ParallelForShards(kShards, [&](size_t) { saw_all += barrier.Arrive(); });
   EXPECT_EQ(saw_all, kShards);
   const std::thread::id caller = std::this_thread::get_id();
   std::vector<std::thread::id> ran_on(kShards);

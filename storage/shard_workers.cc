@@ -4,8 +4,8 @@
 
 namespace fremen::storage {
 
-ShardWorkers::ShardWorkers(uint32_t shards, const std::string& name) {
-  for (uint32_t i = 0; i < shards; ++i) {
+ShardWorkers::ShardWorkers(uint32_t shards, const std::string& name) : shards_(shards) {
+  for (uint32_t i = 1; i < shards; ++i) {
     threads_.emplace_back([this, i] { Loop(i); });
     // Thread names are at most 15 characters.
     pthread_setname_np(threads_.back().native_handle(), (name + std::to_string(i)).substr(0, 15).c_str());
@@ -21,12 +21,20 @@ ShardWorkers::~ShardWorkers() {
   for (std::thread& t : threads_) t.join();
 }
 
-void ShardWorkers::RunOnAll(const std::function<void(uint32_t)>& f) {
-  base::MutexLock lock(&mutex_);
-  task_ = &f;
-  pending_ = static_cast<uint32_t>(threads_.size());
-  ++generation_;
+void ShardWorkers::RunOnAll(const std::function<void(uint32_t)>& f, bool parallel) {
+  if (!parallel || threads_.empty()) {
+    for (uint32_t s = 0; s < shards_; ++s) f(s);
+    return;
+  }
+  {
+    base::MutexLock lock(&mutex_);
+    task_ = &f;
+    pending_ = static_cast<uint32_t>(threads_.size());
+    ++generation_;
+  }
   work_ready_.SignalAll();
+  f(0);
+  base::MutexLock lock(&mutex_);
   while (pending_ != 0) work_done_.Wait(&mutex_);
   task_ = nullptr;
 }
