@@ -39,7 +39,8 @@ absl::Status Expand(const GridGeometry& grid, const CompactCells& cells) {
 
 TEST(CompactCellsTest, RandomScansExpandToTheKeysOfTheirCellsIn2DAnd3D) {
   std::mt19937_64 random(3);
-  for (const GridGeometry& grid : {Grid(100, 100, 100), Grid(37, 5, 1), Grid(1, 1, 7), Grid(300, 2, 3)}) {
+  for (const GridGeometry& grid :
+       {Grid(100, 100, 100), Grid(37, 5, 1), Grid(1, 1, 7), Grid(300, 2, 3), Grid(1030, 3, 1), Grid(600, 2, 2)}) {
     for (int round = 0; round < 20; ++round) {
       std::vector<uint64_t> indices;
       std::vector<float> values;
@@ -62,9 +63,11 @@ TEST(CompactCellsTest, RandomScansExpandToTheKeysOfTheirCellsIn2DAnd3D) {
 }
 
 // A whole-grid sweep (every gap 1, rows ending in the middle of a run of bytes) and a few cells
-// past the grid's end: the run fast path leaves each row at its last cell.
+// past the grid's end: the run fast path leaves each row at its last cell. Rows wider than 256
+// and 512 cells cross the run's x lookups' blocks.
 TEST(CompactCellsTest, AWholeGridSweepExpandsToEveryCellsKeyInOrder) {
-  for (const GridGeometry& grid : {Grid(37, 5, 1), Grid(8, 3, 2), Grid(2, 2, 2), Grid(584, 3, 1)}) {
+  for (const GridGeometry& grid :
+       {Grid(37, 5, 1), Grid(8, 3, 2), Grid(2, 2, 2), Grid(584, 3, 1), Grid(1030, 2, 1), Grid(600, 2, 3)}) {
     std::vector<uint64_t> indices;
     std::vector<float> values;
     for (uint64_t i = 0; i < grid.cell_count() + 3; ++i) {
