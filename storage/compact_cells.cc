@@ -115,7 +115,8 @@ absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& ce
       // A run of neighbours along x, the bulk of a coherent scan: one byte (gap 1) each, up to the
       // row's end, with none of the checks a gap needs. Every cell left in the batch has a byte at
       // least, so the run's bytes are there. Its keys are the row's bits | x's, x's looked up 256
-      // at a time: no chain from one key to the next (office load: 5 cycles a key before).
+      // at a time: no chain of dependent steps from one key to the next, as stepping the key's x
+      // bits made.
       const size_t run_limit = std::min<size_t>(n - i, nx - 1 - cell[0]);
       const size_t run = RunOfOnes(in + at, run_limit);
       const uint64_t row_bits = key & ~x_bits;

@@ -32,9 +32,9 @@ constexpr char kPublishRecord = 'P';  // every shard republished its models here
 constexpr char kQueueFullPayload[] = "type.fremen/storage.QueueFull";
 
 // A group with fewer observations is applied on the applier's thread, shard after shard: waking a
-// shard's worker and waiting for it (two context switches, a few tens of µs on a 2-core VM) costs
-// more than applying a few thousand observations. Small scans (1000 cells, groups of ~7): context
-// switches per batch 2.2 -> 1.7.
+// shard's worker and waiting for it (a futex wake and two context switches) costs more than
+// applying a few thousand observations. Small scans (1000 cells, groups of ~7 batches): context
+// switches per batch 2.2 -> 1.7 (docs/performance.md, "Small scans").
 constexpr uint64_t kParallelApplyObservations = 8192;
 
 std::string ShardDir(const std::string& dir, uint32_t i) { return absl::StrCat(dir, "/shard-", i); }

@@ -18,8 +18,9 @@
 //             "touched" → the dynamic states observed since their last publication (delta varints)
 // Keys are big-endian so that LMDB's order is key order (Morton order for grids).
 //
-// Thread-safety: Apply*, PrepareCheckpoint and Publish* are called by one writer (the map's committer,
-// through the shard's owner; WriteCheckpoint may run on another thread); readers may call the
+// Thread-safety: Apply*, PrepareCheckpoint and Publish* are called by one writer at a time (the
+// map's applier, or a worker it hands the shard to and waits for: ShardWorkers; WriteCheckpoint
+// may run on another thread); readers may call the
 // const query methods concurrently with them —
 // an internal shared mutex keeps a reader from seeing a half-applied batch. The tables readers see
 // are ABSL_GUARDED_BY it: readers hold it shared, the writer changes them holding it exclusively and
