@@ -104,7 +104,6 @@ absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& ce
   // adds 1 to them alone: set the other bits so that the carry skips them, add, keep the x bits.
   const uint64_t x_bits = layout.flat() ? 0x5555555555555555ull : 0x1249249249249249ull;
   const std::array<uint64_t, 256>& spread_low_x = layout.flat() ? SpreadLowXTable().flat : SpreadLowXTable().cube;
-  const auto spread_x = [&](uint64_t x) { return layout.flat() ? SpreadBits2(x) : SpreadBits3(x); };
   uint64_t key = 0;
   uint64_t index = 0;
   std::array<uint32_t, 3> cell = {0, 0, 0};
@@ -122,7 +121,7 @@ absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& ce
       const uint64_t row_bits = key & ~x_bits;
       uint32_t x = cell[0] + 1;
       for (size_t r = 0; r < run;) {
-        const uint64_t high = row_bits | spread_x(x & ~255u);
+        const uint64_t high = row_bits | layout.Key(x & ~255u, 0, 0);
         const size_t stop = std::min<size_t>(run, r + (256 - (x & 255)));
         for (; r < stop; ++r, ++x) keys[i + r] = high | spread_low_x[x & 255];
       }

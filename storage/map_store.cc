@@ -292,8 +292,8 @@ void MapStoreImpl::SplitByShard(Pending& pending) const {
   if (!b.is_history()) {
     const size_t n = b.keys.size();
     const bool all_accepted = pending.ack.rejected == 0;  // Classify's count: no run needs its accept bytes read
+    const uint64_t* const in = b.keys.data();
     for (size_t i = 0; i < n;) {
-      const uint64_t* const in = b.keys.data();
       const uint64_t first = in[i];
       size_t end = i + 1;
       // Four keys a test while the run lasts (a flat brick's row is 32): keys of one brick share
