@@ -107,6 +107,14 @@ absl::Status FremendProcess::AwaitServing() {
 }
 
 FremendProcess::~FremendProcess() {
+  // A daemon that ended by itself while the test still held it crashed or gave up: say so with its
+  // log, rather than let a later call's "cannot connect" be the only trace.
+  if (running_ && Reap(false)) {
+    const std::string log = Log();
+    ADD_FAILURE() << "fremend (pid " << pid_ << ") ended by itself during the test, exit code " << exit_code_
+                  << " (-1: a signal); the end of its log:\n"
+                  << log.substr(log.size() > 4000 ? log.size() - 4000 : 0);
+  }
   if (running_) Kill();
 }
 
