@@ -66,7 +66,7 @@ size_t RunOfOnes(const uint8_t* in, size_t limit) {
 }  // namespace
 
 absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& cells, uint64_t max_cells,
-                                std::vector<uint64_t>& keys, std::vector<float>& values) {
+                                UninitializedVector<uint64_t>& keys, UninitializedVector<float>& values) {
   const bool soft = !cells.probabilities.empty();
   if (soft && !cells.occupied.empty()) return Invalid("compact: set occupied or probabilities, not both");
   const auto* in = reinterpret_cast<const uint8_t*>(cells.indices.data());

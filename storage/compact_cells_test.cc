@@ -32,8 +32,8 @@ void Reference(const GridGeometry& grid, const std::vector<uint64_t>& indices, s
 }
 
 absl::Status Expand(const GridGeometry& grid, const CompactCells& cells) {
-  std::vector<uint64_t> keys;
-  std::vector<float> values;
+  UninitializedVector<uint64_t> keys;
+  UninitializedVector<float> values;
   return ExpandCompactCells(grid, cells, 1 << 28, keys, values);
 }
 
@@ -52,8 +52,9 @@ TEST(CompactCellsTest, RandomScansExpandToTheKeysOfTheirCellsIn2DAnd3D) {
         index += random() % 8 == 0 ? 1 + random() % (2 * grid.size[0] * grid.size[1]) : 1;
       }
       CompactCells cells{EncodeIndexGaps(indices), PackOccupiedBits(values), ""};
-      std::vector<uint64_t> keys, want;
-      std::vector<float> got_values;
+      UninitializedVector<uint64_t> keys;
+      std::vector<uint64_t> want;
+      UninitializedVector<float> got_values;
       ASSERT_TRUE(ExpandCompactCells(grid, cells, 1 << 28, keys, got_values).ok());
       Reference(grid, indices, want);
       EXPECT_EQ(keys, want);
@@ -75,8 +76,9 @@ TEST(CompactCellsTest, AWholeGridSweepExpandsToEveryCellsKeyInOrder) {
       values.push_back(static_cast<float>(i % 3 == 0));
     }
     CompactCells cells{EncodeIndexGaps(indices), PackOccupiedBits(values), ""};
-    std::vector<uint64_t> keys, want;
-    std::vector<float> got_values;
+    UninitializedVector<uint64_t> keys;
+    std::vector<uint64_t> want;
+    UninitializedVector<float> got_values;
     ASSERT_TRUE(ExpandCompactCells(grid, cells, 1 << 28, keys, got_values).ok());
     Reference(grid, indices, want);
     EXPECT_EQ(keys, want) << grid.size[0] << "x" << grid.size[1] << "x" << grid.size[2];
@@ -86,8 +88,8 @@ TEST(CompactCellsTest, AWholeGridSweepExpandsToEveryCellsKeyInOrder) {
 
 TEST(CompactCellsTest, ProbabilitiesAreBytesOver255AsAPatchs) {
   CompactCells cells{EncodeIndexGaps(std::vector<uint64_t>{0, 1, 5}), "", std::string("\x00\x33\xff", 3)};
-  std::vector<uint64_t> keys;
-  std::vector<float> values;
+  UninitializedVector<uint64_t> keys;
+  UninitializedVector<float> values;
   ASSERT_TRUE(ExpandCompactCells(Grid(4, 4, 1), cells, 100, keys, values).ok());
   EXPECT_EQ(values, (std::vector<float>{0.0f, 0.2f, 1.0f}));
   EXPECT_EQ(keys[2], Grid(4, 4, 1).keys().Key(1, 1, 0));
@@ -110,8 +112,8 @@ TEST(CompactCellsTest, MalformedBytesAreInvalidArgumentNamingTheField) {
   EXPECT_EQ(message({two, std::string("\x01\x00", 2), ""}), "compact.occupied has 2 bytes for 2 cells (compact.indices); want one bit per cell, 1 bytes");
   EXPECT_EQ(message({two, "\x04", ""}), "compact.occupied: the bits past the last cell (2) must be 0");
   EXPECT_EQ(message({two, "", "a"}), "compact.probabilities has 1 bytes for 2 cells (compact.indices); want one per cell");
-  std::vector<uint64_t> keys;
-  std::vector<float> values;
+  UninitializedVector<uint64_t> keys;
+  UninitializedVector<float> values;
   EXPECT_EQ(ExpandCompactCells(grid, {two, "\x01", ""}, 1, keys, values).message(),
             "compact.indices holds 2 cells; a batch may hold at most 1");
 }

@@ -58,8 +58,8 @@ absl::Status WriteBatches(const std::string& data_dir, const std::string& map,
 storage::ObservationBatch GenericScan(const std::vector<uint64_t>& ids, const std::vector<float>& values, double t) {
   storage::ObservationBatch batch;
   batch.time = t;
-  batch.keys = ids;
-  batch.values = values;
+  batch.keys.assign(ids.begin(), ids.end());
+  batch.values.assign(values.begin(), values.end());
   return batch;
 }
 

@@ -202,7 +202,7 @@ absl::Status FromHistory(const v1::IngestRequest& request, ObservationBatch& bat
     }
   }
   batch.times.assign(history.times().begin(), history.times().end());
-  std::vector<uint64_t> keys(ids);
+  UninitializedVector<uint64_t> keys(ids);
   for (size_t i = 0; i < ids; ++i) {
     if (by_name && history.names(i).empty()) {
       return Invalid(absl::StrCat("history.names[", i, "] is empty; every state needs a name"));

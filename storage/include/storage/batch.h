@@ -15,6 +15,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "base/uninitialized_vector.h"
 #include "storage/compact_cells.h"
 #include "storage/map_info.h"
 
@@ -40,8 +41,10 @@ struct ObservationBatch {
   uint64_t writer_id = 0;
   uint64_t sequence = 0;
   double time = 0;
-  std::vector<uint64_t> keys;
-  std::vector<float> values;  // one per key
+  // Sized, then written whole, by whatever fills them (the compact scan's expansion above all):
+  // their resize does not zero-fill (base/uninitialized_vector.h).
+  UninitializedVector<uint64_t> keys;
+  UninitializedVector<float> values;  // one per key
   // Cells in the API's compact form, when they came so: keys and values are then its expansion
   // (ExpandCompact), and the log keeps this form instead of them.
   CompactCells compact;

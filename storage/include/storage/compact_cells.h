@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "base/uninitialized_vector.h"
 #include "storage/map_info.h"
 
 namespace fremen::storage {
@@ -35,6 +36,6 @@ inline constexpr uint64_t kNotACellKey = ~uint64_t{0};
 // on a truncated or overlong varint, a gap of 0 (indices not increasing), a value array of the
 // wrong length, set unused bits, both or neither value array, or more than `max_cells` cells.
 absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& cells, uint64_t max_cells,
-                                std::vector<uint64_t>& keys, std::vector<float>& values);
+                                UninitializedVector<uint64_t>& keys, UninitializedVector<float>& values);
 
 }  // namespace fremen::storage
