@@ -117,8 +117,23 @@ absl::Status Connection::CallIdempotent(const CallOptions& call, absl::string_vi
     const absl::Duration delay = backoff.Next();
     if (absl::Now() + delay >= deadline) return status;
     if (options_.retry.on_retry) options_.retry.on_retry(status, delay);
-    absl::SleepFor(delay);
+    PauseBeforeRetry(status, delay);
   }
+}
+
+void Connection::PauseBeforeRetry(const absl::Status& failed, absl::Duration delay) const {
+  const absl::Time until = absl::Now() + delay;
+  // A synchronous channel's reconnection advances only while some call polls it, and after a
+  // failed connection attempt the channel fails every call at once until it is connected again.
+  // So a plain sleep would leave the connection as broken as it was, and every retry would fail
+  // the same way: waiting for the channel to connect is what drives the new attempt. (gRPC 1.51
+  // even reports a connection still being made as failed, with a stale errno, "No such file or
+  // directory", when another of the process's threads held a lock it needed; fremenctl's fleet
+  // commands, a thread per daemon, met it about once in 150 runs.)
+  if (failed.code() == absl::StatusCode::kUnavailable) channel_->WaitForConnected(absl::ToChronoTime(until));
+  // The whole pause still, when connected early: a daemon that answered UNAVAILABLE itself (one
+  // shutting down, a map moving) is not retried sooner.
+  absl::SleepFor(until - absl::Now());
 }
 
 }  // namespace fremen::client

@@ -58,6 +58,8 @@ class Connection {
 
  private:
   explicit Connection(ConnectionOptions options, std::shared_ptr<grpc::Channel> channel);
+  // Sleeps `delay` before a retry of a call that failed with `failed`, connecting the channel meanwhile.
+  void PauseBeforeRetry(const absl::Status& failed, absl::Duration delay) const;
 
   const ConnectionOptions options_;
   const std::shared_ptr<grpc::Channel> channel_;
