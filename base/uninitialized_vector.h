@@ -2,7 +2,7 @@
 // uninitialized, for a buffer that is written whole right after it is sized. std::vector value-
 // initializes them (a memset): on the ingest path that zero-fill of a batch's keys and values, 12
 // bytes a cell overwritten at once by the compact scan's expansion, cost the daemon about 8 % of
-// its CPU time on the office load (docs/performance.md, "The paper's office, streamed").
+// its CPU time on the office load (docs/performance.md, "The zero fill of the decoded arrays").
 //
 // Everything else is std::vector's: push_back, assign(n, v), insert and copies construct as usual.
 // It compares equal to a std::vector<T> of the same elements (found by argument-dependent lookup
