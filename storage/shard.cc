@@ -84,15 +84,21 @@ uint32_t Shard::FindSlot(uint64_t key) const {
 Shard::Brick& Shard::BrickFor(uint64_t key) {
   const uint64_t brick = BrickOf(key);
   if (brick != cached_brick_) {
-    auto [it, inserted] = bricks_.try_emplace(brick, static_cast<uint32_t>(brick_data_.size()));
-    if (inserted) {
-      if (brick < brick_directory_.size()) brick_directory_[brick] = it->second;
-      brick_data_.emplace_back();
-      brick_data_.back().handles.fill(kNone);
-      brick_data_.back().chunk_base.fill(kNone);
+    // A known brick of a grid with a directory without hashing: a coherent scan changes brick
+    // every row of one (32 cells in 2-D).
+    int64_t index = DirectoryLookup(brick);
+    if (index < 0) {
+      auto [it, inserted] = bricks_.try_emplace(brick, static_cast<uint32_t>(brick_data_.size()));
+      if (inserted) {
+        if (brick < brick_directory_.size()) brick_directory_[brick] = it->second;
+        brick_data_.emplace_back();
+        brick_data_.back().handles.fill(kNone);
+        brick_data_.back().chunk_base.fill(kNone);
+      }
+      index = it->second;
     }
     cached_brick_ = brick;
-    cached_brick_index_ = it->second;
+    cached_brick_index_ = static_cast<uint32_t>(index);
   }
   return brick_data_[cached_brick_index_];
 }
