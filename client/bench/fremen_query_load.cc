@@ -97,10 +97,10 @@ Options Parse(int argc, char** argv) {
     else if (key == "size") o.size = static_cast<uint32_t>(std::stoul(value));
     else if (key == "scans") o.scans = static_cast<uint32_t>(std::stoul(value));
     else if (key == "scan-interval") o.scan_interval = std::stod(value);
-    else if (key == "region-reps") o.region_reps = std::stoi(value);
-    else if (key == "series-times") o.series_times = std::stoi(value);
-    else if (key == "series-reps") o.series_reps = std::stoi(value);
-    else if (key == "predict-calls") o.predict_calls = std::stoi(value);
+    else if (key == "region-reps") o.region_reps = std::max(0, std::stoi(value));
+    else if (key == "series-times") o.series_times = std::max(1, std::stoi(value));
+    else if (key == "series-reps") o.series_reps = std::max(0, std::stoi(value));
+    else if (key == "predict-calls") o.predict_calls = std::max(0, std::stoi(value));
     else if (key == "concurrency") o.concurrency = std::stoi(value);
     else if (key == "batch") o.batch = std::stoi(value);
     else if (key == "large-batch") o.large_batch = std::stoi(value);
@@ -551,13 +551,20 @@ int main(int argc, char** argv) {
   const Options options = Parse(argc, argv);
   Bench bench(options);
   if (options.create && !bench.CreateAndFill()) return 1;
-  if (!options.batched_only) {
+  // A count of 0 leaves its part out (e.g. --series-reps=0 --predict-calls=0: regions only, for
+  // profiling the daemon); the series' ceilings need the regions.
+  if (!options.batched_only && options.region_reps > 0) {
     const auto floats = bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT");
     const auto bytes = bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8");
-    bench.RegionSeries(v1::REGION_OUTPUT_FLOAT, "FLOAT", floats);
-    bench.RegionSeries(v1::REGION_OUTPUT_UINT8, "UINT8", bytes);
-    bench.Predict();
+    if (options.series_reps > 0) {
+      bench.RegionSeries(v1::REGION_OUTPUT_FLOAT, "FLOAT", floats);
+      bench.RegionSeries(v1::REGION_OUTPUT_UINT8, "UINT8", bytes);
+    }
   }
-  bench.BatchedPredict();
+  // The batched figures' ceilings are made of single-state calls.
+  if (options.predict_calls > 0) {
+    if (!options.batched_only) bench.Predict();
+    bench.BatchedPredict();
+  }
   return 0;
 }
