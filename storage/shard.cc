@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
+#include "storage/brick_region.h"
 #include "storage/cell_key.h"
 #include "storage/model/kernels/publication.h"
 #include "storage/model/record_codec.h"
@@ -581,24 +583,41 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   std::array<uint32_t, 512> dynamic, published;
   std::array<float*, 512> dynamic_cells, published_cells;
   std::array<float, 512> predicted;
+  // A brick wholly in the box goes sixteen cells at a time (BrickRegion), one partly in it cell by
+  // cell.
+  static_assert(BrickRegion::kNoHandle == kNone && BrickRegion::kNeverChanged == kStaticHandle,
+                "BrickRegion reads the shard's handles");
+  std::optional<BrickRegion> whole_bricks;  // made at the first whole brick
   for (size_t b = 0; b < walk.bricks.size(); ++b) {
     walk.PrefetchHandles(b + 1);
     const Brick* brick = walk.bricks[b].brick;
     const BoxWalk::Cells c = walk.CellsIn(box, b);
     size_t m = 0;
-    for (uint32_t z = c.lo[2]; z < c.hi[2]; ++z) {
-      for (uint32_t y = c.lo[1]; y < c.hi[1]; ++y) {
-        float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
-        const uint32_t yz = walk.spread_y[y & (bs[1] - 1)] | walk.spread_z[z & (bs[2] - 1)];
-        for (uint32_t x = c.lo[0]; x < c.hi[0]; ++x) {
-          const uint32_t handle = brick->handles[yz | walk.spread_x[x & mask_x]];
-          if (handle == kNone) continue;
-          if (handle & kStaticHandle) {
-            row[x] = PredictHandle(handle, table, options);
-          } else {
-            __builtin_prefetch(models_.record(handle));
-            dynamic[m] = handle;
-            dynamic_cells[m++] = &row[x];
+    if (BrickRegion::kAvailable && c.hi[0] - c.lo[0] == bs[0] && c.hi[1] - c.lo[1] == bs[1] &&
+        c.hi[2] - c.lo[2] == bs[2]) {
+      if (!whole_bricks) whole_bricks.emplace(grid_keys_, nx, ny);
+      float* origin = out + ((c.lo[2] - box.lo[2]) * ny + (c.lo[1] - box.lo[1])) * nx + (c.lo[0] - box.lo[0]);
+      whole_bricks->Write(brick->handles.data(), origin,
+                          [&](uint32_t handle, float* cell) ABSL_NO_THREAD_SAFETY_ANALYSIS {  // under the lock above
+                            __builtin_prefetch(models_.record(handle));
+                            dynamic[m] = handle;
+                            dynamic_cells[m++] = cell;
+                          });
+    } else {  // a part of a brick
+      for (uint32_t z = c.lo[2]; z < c.hi[2]; ++z) {
+        for (uint32_t y = c.lo[1]; y < c.hi[1]; ++y) {
+          float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
+          const uint32_t yz = walk.spread_y[y & (bs[1] - 1)] | walk.spread_z[z & (bs[2] - 1)];
+          for (uint32_t x = c.lo[0]; x < c.hi[0]; ++x) {
+            const uint32_t handle = brick->handles[yz | walk.spread_x[x & mask_x]];
+            if (handle == kNone) continue;
+            if (handle & kStaticHandle) {
+              row[x] = PredictHandle(handle, table, options);
+            } else {
+              __builtin_prefetch(models_.record(handle));
+              dynamic[m] = handle;
+              dynamic_cells[m++] = &row[x];
+            }
           }
         }
       }

@@ -1,0 +1,102 @@
+// BrickRegion: the cells of one whole brick written into a box's row-major array of p, sixteen at a
+// time, for region queries (Shard::PredictBox).
+//
+// A brick's 512 handles are in Morton order; a box is row-major. Walking the box and looking up each
+// cell's handle costs a dozen instructions a cell, most of a region's time on a map of mostly
+// never-changed cells. But sixteen consecutive handles of a brick are a 4×4 block of a flat brick
+// (key bits x0 y0 x1 y1) or a 4×2×2 block of a cubic one (x0 y0 z0 x1): four rows of four cells.
+// So a whole brick goes sixteen handles at a time: four loads, their values (a never-changed
+// cell's bit as 0 or 1, an unobserved cell's 0.5) converted together, two shuffles into four rows,
+// four stores; the dynamic handles among the sixteen (a mask of their sign bits) go to the caller,
+// which predicts them and overwrites their cells. A brick only partly in the box is the caller's.
+//
+// Handles as the shard keeps them: kNoHandle (unobserved), kNeverChanged | value, or a dynamic
+// state's index (top bit clear).
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "storage/cell_key.h"
+#include "storage/queries.h"
+
+namespace fremen::storage {
+
+class BrickRegion {
+ public:
+  static constexpr uint32_t kNoHandle = UINT32_MAX;
+  static constexpr uint32_t kNeverChanged = 0x80000000u;
+
+  // For a box nx cells along x and ny along y, of a grid keyed by `keys`.
+  BrickRegion(const GridKeys& keys, uint64_t nx, uint64_t ny);
+
+  // Whether this build has the sixteen-at-a-time path (x86-64 always has SSE2); without it the
+  // caller walks every brick cell by cell.
+  static constexpr bool kAvailable =
+#if defined(__SSE2__)
+      true;
+#else
+      false;
+#endif
+
+  // Position of the brick's cell with handle index i relative to the brick's first cell (its lowest
+  // x, y, z), in the box's row-major order.
+  int64_t offset(uint32_t i) const { return offset_[i]; }
+
+  // Writes p of each never-changed and each unobserved cell of a whole brick, whose first cell is
+  // at `origin` in the box, and calls on_dynamic(handle, float* cell) for each other cell, in
+  // handle order. The dynamic cells' values are left for the caller to write.
+  // REQUIRES: kAvailable; the whole brick is inside the box.
+  template <typename OnDynamic>
+  void Write(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const;
+
+ private:
+  // Handle index of the first cell of row r (0..3) of a group of sixteen, relative to the group's
+  // first: rows 0, 1 are lanes 0 and 2 of the first four handles; rows 2, 3 the same lanes of the
+  // four handles that hold the other half of the block (the next y pair of a flat brick, z + 1 of
+  // a cubic one).
+  std::array<uint32_t, 4> row_start_;
+  bool flat_;
+  std::array<int64_t, 512> offset_;
+};
+
+#if defined(__SSE2__)
+template <typename OnDynamic>
+void BrickRegion::Write(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const {
+  const __m128i none = _mm_set1_epi32(-1), bit = _mm_set1_epi32(1);
+  const __m128 unobserved = _mm_set1_ps(kUnobservedProbability);
+  for (uint32_t g = 0; g < 512; g += 16) {
+    __m128 v[4];
+    uint32_t never_changed_or_none = 0;  // sign bits of the sixteen handles
+    for (int q = 0; q < 4; ++q) {
+      const __m128i h = _mm_loadu_si128(reinterpret_cast<const __m128i*>(handles + g + 4 * q));
+      const __m128 is_none = _mm_castsi128_ps(_mm_cmpeq_epi32(h, none));
+      const __m128 value = _mm_cvtepi32_ps(_mm_and_si128(h, bit));
+      v[q] = _mm_or_ps(_mm_andnot_ps(is_none, value), _mm_and_ps(is_none, unobserved));
+      never_changed_or_none |= static_cast<uint32_t>(_mm_movemask_ps(_mm_castsi128_ps(h))) << (4 * q);
+    }
+    // Flat (x0 y0 x1 y1): v[1] is v[0] at x + 2, v[3] is v[2] at x + 2. Cubic (x0 y0 z0 x1): v[2]
+    // is v[0] at x + 2, v[3] is v[1] at x + 2.
+    const __m128 a = v[0], b = flat_ ? v[1] : v[2], c = flat_ ? v[2] : v[1], d = v[3];
+    _mm_storeu_ps(origin + offset_[g + row_start_[0]], _mm_movelh_ps(a, b));
+    _mm_storeu_ps(origin + offset_[g + row_start_[1]], _mm_movehl_ps(b, a));
+    _mm_storeu_ps(origin + offset_[g + row_start_[2]], _mm_movelh_ps(c, d));
+    _mm_storeu_ps(origin + offset_[g + row_start_[3]], _mm_movehl_ps(d, c));
+    for (uint32_t dynamic = ~never_changed_or_none & 0xffffu; dynamic != 0; dynamic &= dynamic - 1) {
+      const uint32_t i = g + static_cast<uint32_t>(std::countr_zero(dynamic));
+      on_dynamic(handles[i], origin + offset_[i]);
+    }
+  }
+}
+#else
+template <typename OnDynamic>
+void BrickRegion::Write(const uint32_t*, float*, OnDynamic) const {}
+#endif
+
+}  // namespace fremen::storage

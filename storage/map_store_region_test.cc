@@ -1,0 +1,102 @@
+// MapStore::PredictBox over boxes that hold whole bricks (BrickRegion's sixteen-at-a-time path)
+// and parts of bricks (the cell-by-cell walk): every cell must be what a point prediction gives,
+// for a flat and a cubic grid, with never-changed cells at 0 and at 1, unobserved cells, and
+// dynamic ones with and without a published model.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "storage/map_store.h"
+#include "storage/testing/open_map_store.h"
+#include "storage/testing/scans.h"
+#include "testing/temp_dir.h"
+
+namespace fremen::storage {
+namespace {
+
+using testing::GridMap;
+using testing::OpenOrDie;
+using fremen::testing::TempDir;
+
+// Scan i: about 3/4 of the cells (the rest stay unobserved); cells with x % 7 == 0 follow a daily
+// square wave, the others keep one value for ever, 1 where (x + 2y + z) % 3 == 0, else 0.
+ObservationBatch Scan(const MapInfo& map, uint64_t i) {
+  ObservationBatch b;
+  b.writer_id = 1;
+  b.sequence = i + 1;
+  b.time = 1.7e9 + 3600.0 * static_cast<double>(i);
+  const bool day = std::fmod(b.time, 86400.0) < 43200.0;
+  const std::array<uint32_t, 3> size = map.grid.size;
+  for (uint32_t z = 0; z < size[2]; ++z) {
+    for (uint32_t y = 0; y < size[1]; ++y) {
+      for (uint32_t x = 0; x < size[0]; ++x) {
+        if ((x * 7 + y * 13 + z * 3) % 4 != 0) b.keys.push_back(map.grid.keys().Key(x, y, z));  // else never observed
+      }
+    }
+  }
+  std::sort(b.keys.begin(), b.keys.end());
+  for (const uint64_t key : b.keys) {
+    const auto [x, y, z] = map.grid.keys().Cell(key);
+    b.values.push_back((x % 7 == 0 ? day : (x + 2 * y + z) % 3 == 0) ? 1.0f : 0.0f);
+  }
+  return b;
+}
+
+void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& boxes) {
+  TempDir dir;
+  auto store = OpenOrDie(map, dir.path());
+  for (uint64_t i = 0; i < 72; ++i) ASSERT_TRUE(store->Write(Scan(map, i)).ok());
+  ASSERT_TRUE(store->PublishModels().ok());
+  // Then dynamic states without a published model: cells that change only after the publication.
+  ObservationBatch late;
+  late.writer_id = 2;
+  late.sequence = 1;
+  late.time = 1.7e9 + 3600.0 * 80;
+  for (uint32_t x = 1; x < map.grid.size[0]; x += 5) {
+    const uint64_t key = map.grid.keys().Key(x, 1, 0);
+    const auto snapshot = store->Snapshot(key);
+    if (!snapshot || !snapshot->is_static) continue;
+    late.keys.push_back(key);
+    late.values.push_back(1.0f - snapshot->static_state.value());
+  }
+  ASSERT_FALSE(late.keys.empty());
+  ASSERT_TRUE(store->Write(std::move(late)).ok());
+
+  const double t = 1.7e9 + 3600.0 * 90;
+  for (const CellBox& box : boxes) {
+    std::vector<float> region;
+    ASSERT_TRUE(store->PredictBox(box, t, {}, region).ok());
+    ASSERT_EQ(region.size(), box.cell_count());
+    size_t i = 0;
+    size_t kinds[4] = {};  // unobserved, never changed at 0, at 1, dynamic
+    for (uint32_t z = box.lo[2]; z < box.hi[2]; ++z) {
+      for (uint32_t y = box.lo[1]; y < box.hi[1]; ++y) {
+        for (uint32_t x = box.lo[0]; x < box.hi[0]; ++x, ++i) {
+          const uint64_t key = map.grid.keys().Key(x, y, z);
+          const double times[] = {t};
+          ASSERT_EQ(region[i], store->Predict({&key, 1}, times, {})[0]) << x << "," << y << "," << z;
+          const auto snapshot = store->Snapshot(key);
+          ++kinds[!snapshot ? 0 : !snapshot->is_static ? 3 : snapshot->static_state.value() == 1.0f ? 2 : 1];
+        }
+      }
+    }
+    for (size_t kind = 0; kind < 4; ++kind) EXPECT_GT(kinds[kind], 0u) << "kind " << kind;
+  }
+}
+
+TEST(MapStoreRegionTest, FlatBoxesOfWholeAndPartBricksEqualPointPredictions) {
+  // Bricks of 32×16: the first box holds whole bricks and parts, the second parts only along x.
+  ExpectRegionsEqualPoints(GridMap("flat", 80, 40, 1, 2),
+                           {CellBox{{0, 0, 0}, {80, 40, 1}}, CellBox{{1, 0, 0}, {64, 33, 1}}});
+}
+
+TEST(MapStoreRegionTest, CubicBoxesOfWholeAndPartBricksEqualPointPredictions) {
+  // Bricks of 8×8×8.
+  ExpectRegionsEqualPoints(GridMap("cubic", 24, 20, 17, 2),
+                           {CellBox{{0, 0, 0}, {24, 20, 17}}, CellBox{{3, 8, 0}, {24, 16, 16}}});
+}
+
+}  // namespace
+}  // namespace fremen::storage
