@@ -99,8 +99,11 @@ absl::Status ValidateBatch(const MapInfo& map, const ObservationBatch& batch) {
 absl::Status ExpandCompact(const MapInfo& map, ObservationBatch& batch) {
   if (batch.compact.empty()) return absl::OkStatus();
   if (map.kind != MapKind::kGrid) return absl::InvalidArgumentError("compact cells are only for grid maps");
-  absl::Status expanded = ExpandCompactCells(map.grid, batch.compact, kMaxBatchObservations, batch.keys, batch.values);
+  size_t outside = 0;
+  absl::Status expanded =
+      ExpandCompactCells(map.grid, batch.compact, kMaxBatchObservations, batch.keys, batch.values, &outside);
   batch.keys_from_grid.set = expanded.ok();
+  if (expanded.ok()) batch.keys_from_grid.outside = outside;
   return expanded;
 }
 
@@ -119,10 +122,13 @@ BatchAck Classify(const MapInfo& map, const ObservationBatch& batch, std::vector
   // branch-free pass that the compiler vectorises; only a batch with something to reject takes the
   // loop that says what and where.
   // Values expanded from a compact scan's occupied bits are 0 or 1 by construction: that pass
-  // reads the keys alone (office workload under callgrind: Classify 13 -> 3 instructions a cell).
+  // reads the keys alone (office workload under callgrind: Classify 13 -> 3 instructions a cell),
+  // or nothing when the expansion counted the keys past the grid.
   size_t bad = 0;
   const bool values_from_bits = from_grid && !batch.compact.empty() && batch.compact.probabilities.empty();
-  if (values_from_bits) {
+  if (values_from_bits && batch.keys_from_grid.outside) {
+    bad = *batch.keys_from_grid.outside;  // counted by the expansion
+  } else if (values_from_bits) {
     for (size_t i = 0; i < batch.keys.size(); ++i) bad += static_cast<size_t>(batch.keys[i] == kNotACellKey);
   } else if (from_grid) {
     for (size_t i = 0; i < batch.keys.size(); ++i) {

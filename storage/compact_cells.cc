@@ -66,7 +66,8 @@ size_t RunOfOnes(const uint8_t* in, size_t limit) {
 }  // namespace
 
 absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& cells, uint64_t max_cells,
-                                UninitializedVector<uint64_t>& keys, UninitializedVector<float>& values) {
+                                UninitializedVector<uint64_t>& keys, UninitializedVector<float>& values,
+                                size_t* outside_count) {
   const bool soft = !cells.probabilities.empty();
   if (soft && !cells.occupied.empty()) return Invalid("compact: set occupied or probabilities, not both");
   const auto* in = reinterpret_cast<const uint8_t*>(cells.indices.data());
@@ -108,6 +109,7 @@ absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& ce
   uint64_t index = 0;
   std::array<uint32_t, 3> cell = {0, 0, 0};
   bool outside = false;  // index ≥ cell_count: this and every later cell
+  size_t first_outside = n;
   size_t at = 0;
   for (size_t i = 0; i < n; ++i) {
     if (i > 0 && !outside && in[at] == 1 && cell[0] + 1 < nx) {
@@ -151,6 +153,7 @@ absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& ce
     if (!outside && (i == 0 || gap >= cell_count - index)) {
       if (gap >= cell_count - index) {
         outside = true;
+        first_outside = i;
       } else {
         index += gap;
         cell = CellOfIndex(grid, index);
@@ -172,6 +175,7 @@ absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& ce
     key = outside ? kNotACellKey : layout.Key(cell[0], cell[1], cell[2]);
     keys[i] = key;
   }
+  if (outside_count != nullptr) *outside_count = n - first_outside;
   if (soft) {
     const auto* bytes = reinterpret_cast<const uint8_t*>(cells.probabilities.data());
     for (size_t i = 0; i < n; ++i) values[i] = bytes[i] / 255.0f;  // exactly rounded, as a patch's bytes

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "base/compact_scan.h"
@@ -128,10 +129,29 @@ TEST(CompactCellsTest, CellsPastTheGridGetNoCellsKeyAndClassifyRejectsThemAsOuts
   EXPECT_EQ(batch.keys[1], map.grid.keys().Key(9, 9, 0));
   EXPECT_EQ(batch.keys[2], kNotACellKey);
   EXPECT_EQ(batch.keys[3], kNotACellKey);
+  EXPECT_EQ(batch.keys_from_grid.outside, 2u);
   std::vector<uint8_t> accept;
   const BatchAck ack = Classify(map, batch, accept);
   EXPECT_EQ(accept, (std::vector<uint8_t>{1, 1, 0, 0}));
+  EXPECT_EQ(ack.rejected, 2u);
   for (const Rejection& r : ack.rejections) EXPECT_EQ(r.reason, RejectReason::kOutsideMap) << r.index;
+}
+
+// Classify trusts the expansion's count of the cells past the grid instead of reading the keys: the
+// count must be the number of kNotACellKey keys, wherever the grid ends in the scan.
+TEST(CompactCellsTest, TheExpansionCountsTheCellsPastTheGrid) {
+  const GridGeometry grid = Grid(10, 10, 1);
+  for (const std::vector<uint64_t>& indices : std::vector<std::vector<uint64_t>>{
+           {0, 1, 2, 3}, {97, 98, 99}, {98, 99, 100, 101}, {100, 101}, {5, 60, 99, 150}, {}}) {
+    const CompactCells cells{EncodeIndexGaps(indices), PackOccupiedBits(std::vector<float>(indices.size(), 1.0f)), ""};
+    UninitializedVector<uint64_t> keys;
+    UninitializedVector<float> values;
+    size_t outside = 12345;
+    ASSERT_TRUE(ExpandCompactCells(grid, cells, 1 << 20, keys, values, &outside).ok());
+    const size_t not_cells = static_cast<size_t>(std::count(keys.begin(), keys.end(), kNotACellKey));
+    EXPECT_EQ(outside, not_cells) << indices.size() << " cells, the last " << (indices.empty() ? 0 : indices.back());
+    EXPECT_EQ(not_cells, static_cast<size_t>(std::count_if(indices.begin(), indices.end(), [](uint64_t i) { return i >= 100; })));
+  }
 }
 
 TEST(CompactCellsTest, ABatchLogsItsCompactBytesAndDecodesBackToThem) {

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,9 @@ struct ObservationBatch {
   // result.
   struct KeysFromGrid {
     bool set = false;
+    // How many keys are kNotACellKey, when what made them counted them (the compact expansion):
+    // then Classify need not read the keys at all.
+    std::optional<size_t> outside;
     bool operator==(const KeysFromGrid&) const { return true; }
   } keys_from_grid;
   DensePatch patch;           // empty when size has a zero

@@ -31,11 +31,13 @@ struct CompactCells {
 inline constexpr uint64_t kNotACellKey = ~uint64_t{0};
 
 // The keys and values of `cells` in `grid`, into `keys` and `values` (resized to the cell count; a
-// cell past the grid's last gets kNotACellKey).
+// cell past the grid's last gets kNotACellKey, and `outside`, when given, their count: indices
+// increase, so they are the last cells).
 // InvalidArgument naming the field ("compact.indices", "compact.occupied", "compact.probabilities")
 // on a truncated or overlong varint, a gap of 0 (indices not increasing), a value array of the
 // wrong length, set unused bits, both or neither value array, or more than `max_cells` cells.
 absl::Status ExpandCompactCells(const GridGeometry& grid, const CompactCells& cells, uint64_t max_cells,
-                                UninitializedVector<uint64_t>& keys, UninitializedVector<float>& values);
+                                UninitializedVector<uint64_t>& keys, UninitializedVector<float>& values,
+                                size_t* outside = nullptr);
 
 }  // namespace fremen::storage
