@@ -7,12 +7,11 @@ BrickRegion::BrickRegion(const GridKeys& keys, uint64_t nx, uint64_t ny) : flat_
   for (uint32_t z = 0; z < bs[2]; ++z) {
     for (uint32_t y = 0; y < bs[1]; ++y) {
       for (uint32_t x = 0; x < bs[0]; ++x) {
-        offset_[keys.LocalIndex(x, y, z)] =
-            static_cast<int64_t>((uint64_t{z} * ny + y) * nx + x);
+        offset_[keys.LocalIndex(x, y, z)] = static_cast<int64_t>((uint64_t{z} * ny + y) * nx + x);
       }
     }
   }
-  // See Write: lanes 0 and 2 of v[0] and of the vector holding the block's other half.
+  // See WriteSixteenAtATime: lanes 0 and 2 of v[0] and of the vector holding the block's other half.
   const uint32_t other_half = flat_ ? 8 : 4;
   row_start_ = {0, 2, other_half, other_half + 2};
 }

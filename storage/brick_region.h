@@ -36,15 +36,6 @@ class BrickRegion {
   // For a box nx cells along x and ny along y, of a grid keyed by `keys`.
   BrickRegion(const GridKeys& keys, uint64_t nx, uint64_t ny);
 
-  // Whether this build has the sixteen-at-a-time path (x86-64 always has SSE2); without it the
-  // caller walks every brick cell by cell.
-  static constexpr bool kAvailable =
-#if defined(__SSE2__)
-      true;
-#else
-      false;
-#endif
-
   // Position of the brick's cell with handle index i relative to the brick's first cell (its lowest
   // x, y, z), in the box's row-major order.
   int64_t offset(uint32_t i) const { return offset_[i]; }
@@ -52,9 +43,33 @@ class BrickRegion {
   // Writes p of each never-changed and each unobserved cell of a whole brick, whose first cell is
   // at `origin` in the box, and calls on_dynamic(handle, float* cell) for each other cell, in
   // handle order. The dynamic cells' values are left for the caller to write.
-  // REQUIRES: kAvailable; the whole brick is inside the box.
+  // REQUIRES: the whole brick is inside the box.
   template <typename OnDynamic>
-  void Write(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const;
+  void Write(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const {
+#if defined(__SSE2__)  // every x86-64
+    WriteSixteenAtATime(handles, origin, on_dynamic);
+#else
+    WriteEachCell(handles, origin, on_dynamic);
+#endif
+  }
+
+  // Write's two ways, the same result: public so that the tests compare both with the cell by cell
+  // walk on any machine that has SSE2.
+  template <typename OnDynamic>
+  void WriteEachCell(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const {
+    for (uint32_t i = 0; i < 512; ++i) {
+      const uint32_t h = handles[i];
+      if (h & kNeverChanged) {
+        origin[offset_[i]] = h == kNoHandle ? kUnobservedProbability : static_cast<float>(h & 1u);
+      } else {
+        on_dynamic(h, origin + offset_[i]);
+      }
+    }
+  }
+#if defined(__SSE2__)
+  template <typename OnDynamic>
+  void WriteSixteenAtATime(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const;
+#endif
 
  private:
   // Handle index of the first cell of row r (0..3) of a group of sixteen, relative to the group's
@@ -68,7 +83,7 @@ class BrickRegion {
 
 #if defined(__SSE2__)
 template <typename OnDynamic>
-void BrickRegion::Write(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const {
+void BrickRegion::WriteSixteenAtATime(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const {
   const __m128i none = _mm_set1_epi32(-1), bit = _mm_set1_epi32(1);
   const __m128 unobserved = _mm_set1_ps(kUnobservedProbability);
   for (uint32_t g = 0; g < 512; g += 16) {
@@ -94,9 +109,6 @@ void BrickRegion::Write(const uint32_t* handles, float* origin, OnDynamic on_dyn
     }
   }
 }
-#else
-template <typename OnDynamic>
-void BrickRegion::Write(const uint32_t*, float*, OnDynamic) const {}
 #endif
 
 }  // namespace fremen::storage

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 
 #include "storage/map_store.h"
 #include "storage/testing/open_map_store.h"

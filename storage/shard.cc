@@ -593,8 +593,7 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
     const Brick* brick = walk.bricks[b].brick;
     const BoxWalk::Cells c = walk.CellsIn(box, b);
     size_t m = 0;
-    if (BrickRegion::kAvailable && c.hi[0] - c.lo[0] == bs[0] && c.hi[1] - c.lo[1] == bs[1] &&
-        c.hi[2] - c.lo[2] == bs[2]) {
+    if (c.hi[0] - c.lo[0] == bs[0] && c.hi[1] - c.lo[1] == bs[1] && c.hi[2] - c.lo[2] == bs[2]) {
       if (!whole_bricks) whole_bricks.emplace(grid_keys_, nx, ny);
       float* origin = out + ((c.lo[2] - box.lo[2]) * ny + (c.lo[1] - box.lo[1])) * nx + (c.lo[0] - box.lo[0]);
       whole_bricks->Write(brick->handles.data(), origin,
