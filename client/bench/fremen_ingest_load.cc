@@ -16,15 +16,14 @@
 // arithmetic of such an observation (the phasors of the default 24 periods at its time, once per
 // distinct time, and the fold into one state), which no batching amortises.
 //
-// Uses only the API (fremen_proto + gRPC), as any client does. Threads: a writer and a reader per
-// stream; the main thread samples the counters.
+// Uses only the API (fremen_proto + gRPC), as any client does, on gRPC's callback API
+// (client/bench/windowed_ingest.h); the main thread samples the counters.
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
 #include <cmath>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -37,6 +36,7 @@
 #include "CLI/CLI.hpp"
 #include "base/compact_scan.h"
 #include "client/bench/load_stats.h"
+#include "client/bench/windowed_ingest.h"
 #include "fremen/v1/ingest.grpc.pb.h"
 #include "fremen/v1/maps.grpc.pb.h"
 #include "fremen/v1/query.grpc.pb.h"
@@ -286,8 +286,8 @@ void MeasureEncoding(const Options& o) {
               o.cells / decode / 1e6);
 }
 
-// One Ingest stream: a writer keeping up to `window` batches unacknowledged, a reader counting the
-// acknowledgements.
+// One Ingest stream: up to `window` batches unacknowledged, counting the acknowledgements and their
+// latencies.
 class LoadStream {
  public:
   LoadStream(const Options& o, const Client& client, int index)
@@ -295,30 +295,18 @@ class LoadStream {
 
   void Start() {
     stub_ = v1::IngestService::NewStub(client_.NewChannel());
-    context_ = client_.Context();
-    stream_ = stub_->Ingest(context_.get());
     std::mt19937_64 random(index_);
     for (int k = 0; k < kScansPerStream; ++k) scans_.push_back(MakeBatch(o_, index_, k, random));
     sent_at_.resize(static_cast<size_t>(o_.window) * 2);
-    reader_ = std::thread([this] { Read(); });
-    writer_ = std::thread([this] { Write(); });
+    stream_ = std::make_unique<fremen::bench::WindowedIngest>(
+        *stub_, client_.Context(), o_.window, [this](uint64_t sequence) { return Next(sequence); },
+        [this](const v1::IngestResponse& ack) { Acknowledged(ack); });
   }
   // Stops writing (with `drain`, only once --batches are written), waits for the outstanding
   // acknowledgements; the call's status.
   grpc::Status Stop(bool drain = false) {
-    if (drain) {
-      writer_.join();
-      reader_.join();
-      return stream_->Finish();
-    }
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-    }
-    room_.notify_all();
-    writer_.join();
-    reader_.join();
-    return stream_->Finish();
+    if (!drain) stream_->Stop();
+    return stream_->Await();
   }
 
   std::atomic<uint64_t> observations{0};
@@ -331,52 +319,40 @@ class LoadStream {
   }
 
  private:
-  void Write() {
-    for (uint64_t sequence = 0; o_.batches == 0 || sequence < o_.batches; ++sequence) {
-      {
-        std::unique_lock lock(mutex_);
-        room_.wait(lock, [&] { return stopping_ || in_flight_ < o_.window; });
-        if (stopping_) break;
-        ++in_flight_;
-        sent_at_[sequence % sent_at_.size()] = Clock::now();
-      }
-      v1::IngestRequest& scan = scans_[sequence % scans_.size()];
-      scan.set_writer_id(writer_id_);
-      scan.set_sequence(sequence);
-      if (o_.history_states > 0) {
-        // Right after the previous batch's times: a log uploaded in order.
-        const double span = kHistoryInterval * std::ceil(static_cast<double>(o_.cells) / o_.history_states);
-        double& base = history_base_[sequence % scans_.size()];
-        const double shift = kT0 + span * static_cast<double>(sequence) - base;
-        for (double& t : *scan.mutable_history()->mutable_times()) t += shift;
-        base += shift;
-      } else {
-        scan.set_time(kT0 + kScanInterval * static_cast<double>(sequence));
-      }
-      if (!stream_->Write(scan)) break;
+  const v1::IngestRequest* Next(uint64_t sequence) {
+    if (o_.batches > 0 && sequence >= o_.batches) return nullptr;
+    {
+      std::lock_guard lock(mutex_);
+      sent_at_[sequence % sent_at_.size()] = Clock::now();
     }
-    stream_->WritesDone();
+    v1::IngestRequest& scan = scans_[sequence % scans_.size()];
+    scan.set_writer_id(writer_id_);
+    scan.set_sequence(sequence);
+    if (o_.history_states > 0) {
+      // Right after the previous batch's times: a log uploaded in order.
+      const double span = kHistoryInterval * std::ceil(static_cast<double>(o_.cells) / o_.history_states);
+      double& base = history_base_[sequence % scans_.size()];
+      const double shift = kT0 + span * static_cast<double>(sequence) - base;
+      for (double& t : *scan.mutable_history()->mutable_times()) t += shift;
+      base += shift;
+    } else {
+      scan.set_time(kT0 + kScanInterval * static_cast<double>(sequence));
+    }
+    return &scan;
   }
 
-  void Read() {
-    v1::IngestResponse ack;
-    while (stream_->Read(&ack)) {
-      if (ack.has_error() || ack.rejected() > 0) {
-        if (!failed.exchange(true)) {
-          std::fprintf(stderr, "stream %d: batch %lu: %s (%lu rejected)\n", index_,
-                       static_cast<unsigned long>(ack.sequence()), ack.error().message().c_str(),
-                       static_cast<unsigned long>(ack.rejected()));
-        }
+  void Acknowledged(const v1::IngestResponse& ack) {
+    if (ack.has_error() || ack.rejected() > 0) {
+      if (!failed.exchange(true)) {
+        std::fprintf(stderr, "stream %d: batch %lu: %s (%lu rejected)\n", index_,
+                     static_cast<unsigned long>(ack.sequence()), ack.error().message().c_str(),
+                     static_cast<unsigned long>(ack.rejected()));
       }
-      observations += ack.accepted();
-      ++batches;
-      {
-        std::lock_guard lock(mutex_);
-        --in_flight_;
-        latencies_.push_back(Seconds(Clock::now() - sent_at_[ack.sequence() % sent_at_.size()]));
-      }
-      room_.notify_one();
     }
+    observations += ack.accepted();
+    ++batches;
+    std::lock_guard lock(mutex_);
+    latencies_.push_back(Seconds(Clock::now() - sent_at_[ack.sequence() % sent_at_.size()]));
   }
 
   const Options& o_;
@@ -384,18 +360,13 @@ class LoadStream {
   const int index_;
   const uint64_t writer_id_;
   std::unique_ptr<v1::IngestService::Stub> stub_;
-  std::unique_ptr<grpc::ClientContext> context_;
-  std::unique_ptr<grpc::ClientReaderWriter<v1::IngestRequest, v1::IngestResponse>> stream_;
-  std::vector<v1::IngestRequest> scans_;
+  std::vector<v1::IngestRequest> scans_;  // cycled through; one is being written at a time
   std::vector<double> history_base_ = std::vector<double>(kScansPerStream, kT0);  // each history's first time
-  std::thread reader_, writer_;
-
   std::mutex mutex_;
-  std::condition_variable room_;
-  int in_flight_ = 0;
-  bool stopping_ = false;
   std::vector<Clock::time_point> sent_at_;  // by sequence modulo its size (> window)
   std::vector<double> latencies_;
+  // Last: destroyed first, its call ends before what its reactions use goes.
+  std::unique_ptr<fremen::bench::WindowedIngest> stream_;
 };
 
 // --batches: every stream sends its fixed number of batches; false when a stream failed.

@@ -15,15 +15,14 @@
 // writes as new writers, from the same simulated start: use a fresh map (or --map) to keep a run's
 // model to itself.
 //
-// Uses only the API (fremen_proto + gRPC), as any client does.
+// Uses only the API (fremen_proto + gRPC), as any client does, on gRPC's callback API
+// (client/bench/windowed_ingest.h).
 #include <grpcpp/grpcpp.h>
 
 #include <atomic>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <memory>
-#include <mutex>
 #include <random>
 #include <string>
 #include <thread>
@@ -33,6 +32,7 @@
 #include "base/compact_scan.h"
 #include "client/bench/load_stats.h"
 #include "client/bench/office_floor.h"
+#include "client/bench/windowed_ingest.h"
 #include "fremen/v1/ingest.grpc.pb.h"
 #include "fremen/v1/maps.grpc.pb.h"
 
@@ -124,77 +124,58 @@ class Robot {
       : o_(o), floor_(floor), scans_(scans), first_(first), count_(count), writer_id_(std::random_device()() | 1ull << 40) {}
 
   void Start() {
+    scan_.set_map(o_.map);
+    scan_.set_writer_id(writer_id_);
+    std::vector<uint64_t> indices(count_);
+    for (uint64_t i = 0; i < count_; ++i) indices[i] = first_ + i;
+    scan_.mutable_compact()->set_indices(fremen::EncodeIndexGaps(indices));  // the same band every time
     stub_ = v1::IngestService::NewStub(NewChannel(o_));
-    context_ = Context(o_);
-    stream_ = stub_->Ingest(context_.get());
-    reader_ = std::thread([this] { Read(); });
-    writer_ = std::thread([this] { Write(); });
+    stream_ = std::make_unique<fremen::bench::WindowedIngest>(
+        *stub_, Context(o_), o_.window, [this](uint64_t k) { return Next(k); },
+        [this](const v1::IngestResponse& ack) { Acknowledged(ack); });
   }
   // Waits for every scan's acknowledgement; the call's status.
   grpc::Status Finish() {
-    writer_.join();
-    reader_.join();
-    return stream_->Finish();
+    const grpc::Status status = stream_->Await();
+    failed = failed || observations < scans_ * count_;
+    return status;
   }
+
+  // Whether the stream ended before every scan was acknowledged (the daemon ended it).
+  bool EndedShort() const { return stream_->Ended() && observations < scans_ * count_; }
 
   std::atomic<uint64_t> observations{0};
   std::atomic<bool> failed{false};
-  uint64_t wire_bytes = 0;  // of the last scan sent
+  std::atomic<uint64_t> wire_bytes{0};  // of the last scan sent
 
  private:
-  void Write() {
-    v1::IngestRequest scan;
-    scan.set_map(o_.map);
-    scan.set_writer_id(writer_id_);
-    std::vector<uint64_t> indices(count_);
-    for (uint64_t i = 0; i < count_; ++i) indices[i] = first_ + i;
-    scan.mutable_compact()->set_indices(fremen::EncodeIndexGaps(indices));  // the same band every time
-    for (uint64_t k = 0; k < scans_; ++k) {
-      {
-        std::unique_lock lock(mutex_);
-        room_.wait(lock, [&] { return in_flight_ < o_.window || failed; });
-        if (failed) break;
-        ++in_flight_;
-      }
-      const double time = kStart + kScanInterval * static_cast<double>(k);
-      scan.set_sequence(k);
-      scan.set_time(time);
-      scan.mutable_compact()->set_occupied(floor_.Occupied(first_, count_, time));
-      wire_bytes = scan.ByteSizeLong();
-      if (!stream_->Write(scan)) break;
-    }
-    stream_->WritesDone();
+  // The scan at time k: the same band, this time's occupied bits.
+  const v1::IngestRequest* Next(uint64_t k) {
+    if (k >= scans_ || failed) return nullptr;
+    const double time = kStart + kScanInterval * static_cast<double>(k);
+    scan_.set_sequence(k);
+    scan_.set_time(time);
+    scan_.mutable_compact()->set_occupied(floor_.Occupied(first_, count_, time));
+    wire_bytes = scan_.ByteSizeLong();
+    return &scan_;
   }
 
-  void Read() {
-    v1::IngestResponse ack;
-    while (stream_->Read(&ack)) {
-      if ((ack.has_error() || ack.rejected() > 0) && !failed.exchange(true)) {
-        std::fprintf(stderr, "robot %lu: scan %lu: %s (%lu rejected)\n", static_cast<unsigned long>(first_),
-                     static_cast<unsigned long>(ack.sequence()), ack.error().message().c_str(),
-                     static_cast<unsigned long>(ack.rejected()));
-      }
-      observations += ack.accepted();
-      {
-        std::lock_guard lock(mutex_);
-        --in_flight_;
-      }
-      room_.notify_one();
+  void Acknowledged(const v1::IngestResponse& ack) {
+    if ((ack.has_error() || ack.rejected() > 0) && !failed.exchange(true)) {
+      std::fprintf(stderr, "robot %lu: scan %lu: %s (%lu rejected)\n", static_cast<unsigned long>(first_),
+                   static_cast<unsigned long>(ack.sequence()), ack.error().message().c_str(),
+                   static_cast<unsigned long>(ack.rejected()));
     }
-    failed = failed || observations < scans_ * count_;
-    room_.notify_one();
+    observations += ack.accepted();
   }
 
   const Options& o_;
   const OfficeFloor& floor_;
   const uint64_t scans_, first_, count_, writer_id_;
   std::unique_ptr<v1::IngestService::Stub> stub_;
-  std::unique_ptr<grpc::ClientContext> context_;
-  std::unique_ptr<grpc::ClientReaderWriter<v1::IngestRequest, v1::IngestResponse>> stream_;
-  std::thread reader_, writer_;
-  std::mutex mutex_;
-  std::condition_variable room_;
-  int in_flight_ = 0;
+  v1::IngestRequest scan_;  // being written until the next one is made
+  // Last: destroyed first, its call ends before what its reactions use goes.
+  std::unique_ptr<fremen::bench::WindowedIngest> stream_;
 };
 
 // How fast one core makes whole-floor scans (the occupied bits; the indices are made once), in
@@ -245,7 +226,7 @@ bool Run(const Options& o, const OfficeFloor& floor) {
     // Sleeps a window, or less once the run is nearly done.
     const uint64_t now_total = total();
     bool any_failed = false;
-    for (auto& r : robots) any_failed = any_failed || r->failed;
+    for (auto& r : robots) any_failed = any_failed || r->failed || r->EndedShort();
     if (now_total >= expected || any_failed) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const auto now = Clock::now();
