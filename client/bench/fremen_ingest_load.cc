@@ -1,5 +1,5 @@
 // fremen_ingest_load: the ingest load generator (README.md, "Benchmarks"). Against a running
-// fremend it streams scans of grid cells by index (default: 4 streams of 10k-cell scans, at most 8
+// fremend it streams scans of grid cells by index (default: 4 streams of 10k-cell scans, at most 64
 // unacknowledged batches per stream, acknowledged only once durable) and prints the cell
 // observations per second acknowledged (the median of --repetitions windows), the batch rate and
 // the acknowledgement latency. It first prints what one scan costs to encode and decode (the
@@ -60,7 +60,7 @@ struct Options {
   uint32_t grid = 100;  // cells along each axis of the map, when created
   int streams = 4;
   uint32_t cells = 10000;  // per scan
-  int window = 8;          // unacknowledged batches per stream
+  int window = 64;         // unacknowledged batches per stream (the C++ and Python clients' default)
   double warmup = 2;       // seconds before the first window
   double seconds = 5;      // per repetition
   int repetitions = 5;
@@ -487,7 +487,7 @@ int main(int argc, char** argv) {
   app.add_option("--grid", o.grid, "cells along each axis of a created map")->capture_default_str()->check(CLI::Range(1, 2048));
   app.add_option("--streams", o.streams, "concurrent Ingest streams")->capture_default_str()->check(CLI::Range(1, 256));
   app.add_option("--cells", o.cells, "cells per scan")->capture_default_str()->check(CLI::Range(1, 1 << 24));
-  app.add_option("--window", o.window, "unacknowledged batches per stream")->capture_default_str()->check(CLI::Range(1, 1024));
+  app.add_option("--window", o.window, "unacknowledged batches per stream (the clients' default)")->capture_default_str()->check(CLI::Range(1, 1024));
   app.add_option("--warmup", o.warmup, "seconds before measuring")->capture_default_str();
   app.add_option("--seconds", o.seconds, "seconds per measured window")->capture_default_str();
   app.add_option("--repetitions", o.repetitions, "measured windows (the median is reported)")->capture_default_str()->check(CLI::Range(1, 1000));

@@ -53,7 +53,7 @@ struct Options {
   std::string map = "office-load";
   std::string token;
   int streams = 4;
-  int window = 4;
+  int window = 64;  // unacknowledged scans per robot: the C++ and Python clients' default
   double days = 7;
   double seconds = 10;  // per printed window
   bool ceilings = true;
@@ -274,7 +274,7 @@ int main(int argc, char** argv) {
   app.add_option("--streams", o.streams, "robots, each scanning a band of the floor on its own stream")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
-  app.add_option("--window", o.window, "unacknowledged scans per robot")->capture_default_str()->check(CLI::Range(1, 1024));
+  app.add_option("--window", o.window, "unacknowledged scans per robot (the clients' default)")->capture_default_str()->check(CLI::Range(1, 1024));
   app.add_option("--days", o.days, "simulated days to stream, from a Monday 00:00 UTC")
       ->capture_default_str()
       ->check(CLI::Range(1.0 / 17280, 365.0));

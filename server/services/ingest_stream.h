@@ -58,9 +58,13 @@ class IngestStream final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
                            public CallTracker::Drainable,
                            public std::enable_shared_from_this<IngestStream> {
  public:
-  // Batches read but not yet answered, per stream: enough to keep a robot's link and the store's
-  // group commit busy, few enough that a stalled stream holds little memory.
-  static constexpr size_t kMaxUnanswered = 8;
+  // Batches read but not yet answered, per stream: the window the C++ and Python clients keep by
+  // default (max_unacknowledged, max_in_flight), so that their batches wait in the store's group
+  // commit, not in HTTP/2 flow control. At 8, 1000-cell scans ran at 12-13k batches/s and a client
+  // keeping 64 unanswered was slower than one keeping 8; at 64, 22-28k (docs/performance.md,
+  // "The stream's window"). The memory it lets a stream hold is the responses' slots: the batches
+  // themselves are in the store, whose queue is bounded (MapStore::Submit refuses past it).
+  static constexpr size_t kMaxUnanswered = 64;
 
   // Starts the call; the reactor frees itself once the call is done and the store is done with it.
   static IngestStream* Start(const ServiceDeps& deps, grpc::CallbackServerContext* context);
