@@ -1075,12 +1075,18 @@ absl::StatusOr<BoxSeries> MapStoreImpl::PlanBoxSeries(const CellBox& box, double
   return plan;
 }
 
-void MapStoreImpl::PredictBoxSeries(const BoxSeries& plan, double t, std::vector<float>& out) const {
-  out.resize(plan.varying_keys.size());
-  const model::PhasorTable table(settings_->periods, t);
+void MapStoreImpl::PredictBoxSeries(const BoxSeries& plan, std::span<const double> times,
+                                    std::vector<float>& out) const {
+  const size_t n = plan.varying_keys.size();
+  out.resize(times.size() * n);
+  std::vector<model::PhasorTable> tables;
+  tables.reserve(times.size());
+  for (double t : times) tables.emplace_back(settings_->periods, t);
   ParallelForShards(
       shards_.size(),
-      [&](size_t s) { shards_[s]->PredictDynamic(plan.shards[s].dynamic, plan.shards[s].at, table, plan.options, out.data()); },
+      [&](size_t s) {
+        shards_[s]->PredictDynamic(plan.shards[s].dynamic, plan.shards[s].at, tables, plan.options, out.data(), n);
+      },
       /*parallel=*/out.size() >= kParallelPredictions);
 }
 

@@ -62,7 +62,7 @@ class MapStoreImpl final : public MapStore {
   absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
                           std::span<float> out) const override;
   absl::StatusOr<BoxSeries> PlanBoxSeries(const CellBox& box, double t, const PredictOptions& options) const override;
-  void PredictBoxSeries(const BoxSeries& plan, double t, std::vector<float>& out) const override;
+  void PredictBoxSeries(const BoxSeries& plan, std::span<const double> times, std::vector<float>& out) const override;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const override;
   std::vector<uint8_t> Observed(std::span<const uint64_t> keys) const override;
   std::vector<float> PredictWithObserved(std::span<const uint64_t> keys, std::span<const double> times,

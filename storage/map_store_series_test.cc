@@ -21,7 +21,7 @@ using fremen::testing::TempDir;
 // The box at t as the series gives it: constant cells from the plan, varying ones predicted at t.
 std::vector<float> Assemble(const MapStore& store, const BoxSeries& plan, double t) {
   std::vector<float> frame = plan.constant, varying;
-  store.PredictBoxSeries(plan, t, varying);
+  store.PredictBoxSeries(plan, {&t, 1}, varying);
   EXPECT_EQ(varying.size(), plan.varying.size());
   for (size_t i = 0; i < plan.varying.size(); ++i) frame[plan.varying[i]] = varying[i];
   return frame;
@@ -66,6 +66,18 @@ Counts CheckEveryOption(const MapStore& store, const CellBox& box) {
       std::vector<float> region;
       EXPECT_TRUE(store.PredictBox(box, t, c.options, region).ok());
       ExpectSameBits(Assemble(store, *plan, t), region, absl::StrCat(what, " at ", t));
+    }
+    // All the times in one call: time g's values are the g-th run of the output, each as alone.
+    std::vector<float> together;
+    store.PredictBoxSeries(*plan, times, together);
+    const size_t n = plan->varying.size();
+    EXPECT_EQ(together.size(), std::size(times) * n) << what;
+    if (together.size() != std::size(times) * n) continue;
+    for (size_t g = 0; g < std::size(times); ++g) {
+      std::vector<float> alone;
+      store.PredictBoxSeries(*plan, {&times[g], 1}, alone);
+      ExpectSameBits(std::vector<float>(together.begin() + g * n, together.begin() + (g + 1) * n), alone,
+                     absl::StrCat(what, ", time ", g, " of ", std::size(times), " in one call"));
     }
   }
   return counts;

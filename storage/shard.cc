@@ -424,7 +424,7 @@ void Shard::PredictKeys(std::span<const uint64_t> keys, std::span<const uint32_t
     if (observed) {
       for (size_t k = 0; k < count; ++k) observed[positions[k]] = handles[k] != kNone;
     }
-    PredictHandles({handles.data(), count}, positions, table, options, out);
+    PredictHandles({handles.data(), count}, positions, {&table, 1}, options, out, /*stride=*/0);
   }
 }
 
@@ -506,32 +506,46 @@ bool Shard::VariesWithTime(uint32_t handle, const PredictOptions& options) const
 }
 
 void Shard::PredictDynamic(std::span<const uint32_t> dynamic, std::span<const uint32_t> at,
-                           const model::PhasorTable& table, const PredictOptions& options, float* out) const {
+                           std::span<const model::PhasorTable> tables, const PredictOptions& options, float* out,
+                           size_t stride) const {
   base::ReaderMutexLock lock(&mutex_);
   constexpr size_t kBatch = 512;
   for (size_t begin = 0; begin < dynamic.size(); begin += kBatch) {
     const size_t count = std::min(dynamic.size() - begin, kBatch);
-    PredictHandles(dynamic.subspan(begin, count), at.data() + begin, table, options, out);
+    PredictHandles(dynamic.subspan(begin, count), at.data() + begin, tables, options, out, stride);
   }
 }
 
-void Shard::PredictHandles(std::span<const uint32_t> handles, const uint32_t* at, const model::PhasorTable& table,
-                           const PredictOptions& options, float* out) const {
-  std::array<uint32_t, 512> published;
-  std::array<uint32_t, 512> published_at;
+void Shard::PredictHandles(std::span<const uint32_t> handles, const uint32_t* at,
+                           std::span<const model::PhasorTable> tables, const PredictOptions& options, float* out,
+                           size_t stride) const {
+  if (tables.empty()) return;
+  std::array<uint32_t, 512> published, published_at, other, other_at;
   std::array<float, 512> predicted;
-  size_t n = 0;
+  size_t n = 0, m = 0;
+  // The other states at the first time right away (a single time, the common case, keeps no list).
+  const bool more_times = tables.size() > 1;
   for (size_t k = 0; k < handles.size(); ++k) {
     const uint32_t handle = handles[k];
     if (handle != kNone && !(handle & kStaticHandle) && models_.published(handle)) {
       published[n] = handle;
       published_at[n++] = at[k];
     } else {
-      out[at[k]] = PredictHandle(handle, table, options);
+      out[at[k]] = PredictHandle(handle, tables[0], options);
+      if (more_times) {
+        other[m] = handle;
+        other_at[m++] = at[k];
+      }
     }
   }
-  PredictPublished({published.data(), n}, table, options, predicted.data());
-  for (size_t j = 0; j < n; ++j) out[published_at[j]] = predicted[j];
+  for (size_t g = 0; g < tables.size(); ++g) {
+    float* const frame = out + g * stride;
+    if (g > 0) {
+      for (size_t j = 0; j < m; ++j) frame[other_at[j]] = PredictHandle(other[j], tables[g], options);
+    }
+    PredictPublished({published.data(), n}, tables[g], options, predicted.data());
+    for (size_t j = 0; j < n; ++j) frame[published_at[j]] = predicted[j];
+  }
 }
 
 void Shard::PredictBoxConstant(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,

@@ -147,10 +147,12 @@ class Shard {
   // the shard's life: dynamic states are only ever added.
   void PredictBoxConstant(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
                           float* out, uint32_t* dynamic) const;
-  // out[at[i]] = p(t) of dynamic state dynamic[i], as PredictBox gives it (published models through
-  // the region kernel together): the second half, at each time, without a lookup per state.
+  // out[g * stride + at[i]] = p(t_g) of dynamic state dynamic[i] at each tables[g]'s time, as
+  // PredictBox gives it (published models through the region kernel together): the second half,
+  // at a few times at once, without a lookup per state.
   void PredictDynamic(std::span<const uint32_t> dynamic, std::span<const uint32_t> at,
-                      const model::PhasorTable& table, const PredictOptions& options, float* out) const;
+                      std::span<const model::PhasorTable> tables, const PredictOptions& options, float* out,
+                      size_t stride) const;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const;
   // Whether the state was ever observed (cheap: one brick lookup).
   bool Observed(uint64_t key) const;
@@ -217,10 +219,13 @@ class Shard {
   // Only the slot's published model changes: the next checkpoint writes its published record
   // alone, unless something else marks the slot dirty meanwhile.
   void MarkPublishedDirty(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
-  // out[at[i]] = p(t) of the state behind handles[i], for i < handles.size() ≤ 512: the published
-  // models through the region kernel together, the others one by one.
-  void PredictHandles(std::span<const uint32_t> handles, const uint32_t* at, const model::PhasorTable& table,
-                      const PredictOptions& options, float* out) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
+  // out[g * stride + at[i]] = p(t_g) of the state behind handles[i], for i < handles.size() ≤ 512
+  // and each tables[g] (the time t_g): the published models through the region kernel together,
+  // the others one by one. The handles are sorted out once for all the times, and their records,
+  // read at the first time, are still in cache at the next.
+  void PredictHandles(std::span<const uint32_t> handles, const uint32_t* at,
+                      std::span<const model::PhasorTable> tables, const PredictOptions& options, float* out,
+                      size_t stride) const ABSL_SHARED_LOCKS_REQUIRED(mutex_);
   // A box walked brick by brick (ForEachBoxCell, PredictBox): this shard's bricks in the box, in
   // the box's order, and a cell's index in its brick as the sum of its axes' bits, spread (three
   // lookups per cell instead of a Morton encoding).

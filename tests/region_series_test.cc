@@ -60,6 +60,27 @@ class RegionSeriesTest : public QueryServiceTest {
     return out;
   }
 
+  // Each frame t equals PredictRegion of the whole lab at times[t] with `single`'s other fields,
+  // value for value.
+  void ExpectEachFrameIsPredictRegion(const std::vector<std::vector<std::string>>& frames,
+                                      const std::vector<double>& times, v1::PredictRegionRequest single) {
+    const uint64_t cells = uint64_t{kNx} * kNy;
+    single.set_map("lab");
+    *single.mutable_lo() = Cell(0, 0);
+    *single.mutable_hi() = Cell(kNx, kNy);
+    for (size_t t = 0; t < times.size(); ++t) {
+      single.set_time(times[t]);
+      const RegionResult region = Region(single);
+      ASSERT_TRUE(region.status.ok()) << region.status.error_message();
+      std::vector<std::string> expected;
+      for (const auto& chunk : region.chunks) {
+        for (std::string& v : Values(chunk)) expected.push_back(std::move(v));
+      }
+      ASSERT_EQ(frames[t].size(), expected.size());
+      for (uint64_t i = 0; i < cells; ++i) ASSERT_EQ(frames[t][i], expected[i]) << "time " << t << " cell " << i;
+    }
+  }
+
   // The frames of a series stream, checking its layout (query.proto): the base in order, then the
   // times in order, each chunk where the previous ended. `varying` gets the varying cells' indices
   // and `wire_values` the values the stream carried.
@@ -161,24 +182,32 @@ TEST_F(RegionSeriesTest, EveryFrameIsPredictRegionAtItsTime) {
     }
 
     v1::PredictRegionRequest single;
-    single.set_map("lab");
-    *single.mutable_lo() = Cell(0, 0);
-    *single.mutable_hi() = Cell(kNx, kNy);
     single.set_output(c.output);
     single.set_confidence(0.6f);
     *single.mutable_options() = request.options();
-    for (size_t t = 0; t < times.size(); ++t) {
-      single.set_time(times[t]);
-      const RegionResult region = Region(single);
-      ASSERT_TRUE(region.status.ok()) << region.status.error_message();
-      std::vector<std::string> expected;
-      for (const auto& chunk : region.chunks) {
-        for (std::string& v : Values(chunk)) expected.push_back(std::move(v));
-      }
-      ASSERT_EQ(frames[t].size(), expected.size());
-      for (uint64_t i = 0; i < cells; ++i) ASSERT_EQ(frames[t][i], expected[i]) << "time " << t << " cell " << i;
-    }
+    ExpectEachFrameIsPredictRegion(frames, times, single);
+    ASSERT_FALSE(HasFatalFailure());
   }
+}
+
+// More times than one block of times holds (kMaxSeriesTimesPerBlock, 16, for a box this small):
+// three blocks, the last one short, and every frame still PredictRegion at its time, in order.
+TEST_F(RegionSeriesTest, ManyTimesGoInBlocksOfSeveralEachFrameAtItsTime) {
+  CreateAndFillMaps();
+  ASSERT_FALSE(HasFatalFailure());
+  std::vector<double> times;
+  for (int i = 0; i < 37; ++i) times.push_back(kQueryTime + 1877.0 * i);
+  const uint64_t cells = uint64_t{kNx} * kNy;
+  const SeriesResult series = Series(WholeLabSeries(v1::REGION_OUTPUT_FLOAT, times));
+  ASSERT_TRUE(series.status.ok()) << series.status.error_message();
+  std::vector<uint64_t> varying;
+  uint64_t wire_values = 0;
+  const auto frames = Frames(series, cells, times.size(), varying, wire_values);
+  ASSERT_FALSE(HasFailure());
+  EXPECT_GT(varying.size(), 0u);
+  v1::PredictRegionRequest single;
+  single.set_output(v1::REGION_OUTPUT_FLOAT);
+  ExpectEachFrameIsPredictRegion(frames, times, single);
 }
 
 // A sub-box of a 3-D grid, chunks of the server's choice.

@@ -48,15 +48,17 @@ absl::Status RegionSeriesStream::Prepare(const v1::PredictRegionSeriesRequest& r
   confidence_ = request.confidence();
   times_.assign(request.times().begin(), request.times().end());
   chunk_cells_ = ChunkCells(request.chunk_cells(), output_);
-  // Block 0 (the base); it adds the frames' blocks once it knows the varying cells.
-  SetBlocks(1, CeilDiv(box_.cell_count(), BaseChunkCells(chunk_cells_, output_)));
+  // Block 0 (the base); it adds the frames' blocks once it knows the varying cells. A block's
+  // chunks: the base's, or a block of times' (each time's varying cells, at most the box).
+  SetBlocks(1, std::max(CeilDiv(box_.cell_count(), BaseChunkCells(chunk_cells_, output_)),
+                        kMaxSeriesTimesPerBlock * CeilDiv(box_.cell_count(), chunk_cells_)));
   set_total_values(box_.cell_count());
   return absl::OkStatus();
 }
 
 bool RegionSeriesStream::ComputesInline(uint64_t i) const {
   // plan_ is set by block 0, before block 1 is asked for.
-  const uint64_t cells = i == 0 ? box_.cell_count() : plan_->varying.size();
+  const uint64_t cells = i == 0 ? box_.cell_count() : plan_->varying.size() * times_per_block_;
   return cells <= kInlineRegionCells;
 }
 
@@ -107,19 +109,28 @@ absl::Status RegionSeriesStream::ComputeBase(Chunks& chunks) {
 absl::Status RegionSeriesStream::ComputeBlock(uint64_t i, Chunks& chunks, uint64_t& more_blocks) {
   if (i == 0) {
     if (absl::Status s = ComputeBase(chunks); !s.ok()) return s;
-    // One block a time; none when nothing varies.
-    if (!plan_->varying.empty()) more_blocks = times_.size();
+    // Blocks of a few times; none when nothing varies.
+    const uint64_t varying = plan_->varying.size();
+    if (varying > 0) {
+      times_per_block_ = std::clamp<uint64_t>(kSeriesBlockValues / varying, 1, kMaxSeriesTimesPerBlock);
+      more_blocks = CeilDiv(times_.size(), times_per_block_);
+    }
     return absl::OkStatus();
   }
-  const uint32_t time_index = static_cast<uint32_t>(i - 1);
-  map_->PredictBoxSeries(*plan_, times_[time_index], scratch_);
-  for (uint64_t offset = 0; offset < scratch_.size(); offset += chunk_cells_) {
-    const uint64_t n = std::min(chunk_cells_, scratch_.size() - offset);
-    std::unique_ptr<Response> chunk = NewChunk();
-    chunk->set_time_index(time_index);
-    chunk->set_offset(offset);
-    EncodeRegionValues(output_, confidence_, std::span<const float>(scratch_).subspan(offset, n), *chunk);
-    chunks.push_back(std::move(chunk));
+  const uint64_t first = (i - 1) * times_per_block_;
+  const uint64_t count = std::min<uint64_t>(times_per_block_, times_.size() - first);
+  map_->PredictBoxSeries(*plan_, std::span<const double>(times_).subspan(first, count), scratch_);
+  const uint64_t varying = plan_->varying.size();
+  for (uint64_t g = 0; g < count; ++g) {
+    const std::span<const float> frame = std::span<const float>(scratch_).subspan(g * varying, varying);
+    for (uint64_t offset = 0; offset < varying; offset += chunk_cells_) {
+      const uint64_t n = std::min(chunk_cells_, varying - offset);
+      std::unique_ptr<Response> chunk = NewChunk();
+      chunk->set_time_index(static_cast<uint32_t>(first + g));
+      chunk->set_offset(offset);
+      EncodeRegionValues(output_, confidence_, frame.subspan(offset, n), *chunk);
+      chunks.push_back(std::move(chunk));
+    }
   }
   return absl::OkStatus();
 }

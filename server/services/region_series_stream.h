@@ -3,9 +3,11 @@
 // vary with time, and the values of the others — once, then per time the varying cells' values.
 //
 // Block 0 plans the box (MapStore::PlanBoxSeries: one pass over it) and cuts the base into chunks;
-// block 1 + i predicts the varying cells at times[i] (MapStore::PredictBoxSeries: one phasor table,
-// the shards in parallel) and cuts them into chunks. Memory: the plan (about 20 bytes a cell of
-// the box, hence the bound on the box) and a block's chunks.
+// each later block predicts the varying cells at a few consecutive times (MapStore::
+// PredictBoxSeries: one phasor table a time, the shards in parallel, each model record read once
+// for the block's times) and cuts them into chunks, time by time. Memory: the plan (about 20 bytes
+// a cell of the box, hence the bound on the box) and a block's values (at most
+// kSeriesBlockValues floats, or one time's).
 //
 // Thread-safety: as BlockStream's.
 #pragma once
@@ -25,6 +27,12 @@ namespace fremen::server {
 // The most cells of a series' box (its plan holds ~20 bytes a cell: 80 MiB at most), and times.
 inline constexpr uint64_t kMaxSeriesCells = uint64_t{1} << 22;
 inline constexpr int kMaxSeriesTimes = 1000;
+
+// Values one block of times predicts at most (4 MiB of floats), and its most times: enough times
+// that a block's records, read at its first time, serve the others from cache (a 1M-cell box with
+// 12 % varying cells: 8 times a block), few enough that memory stays bounded.
+inline constexpr uint64_t kSeriesBlockValues = uint64_t{1} << 20;
+inline constexpr uint64_t kMaxSeriesTimesPerBlock = 16;
 
 class RegionSeriesStream final
     : public BlockStream<v1::PredictRegionSeriesRequest, v1::PredictRegionSeriesResponse> {
@@ -54,6 +62,7 @@ class RegionSeriesStream final
 
   // Block 0's, read by the later blocks (one computation at a time, in order).
   std::optional<storage::BoxSeries> plan_;
+  uint64_t times_per_block_ = 1;
   std::vector<float> scratch_;  // the computing thread's
 };
 

@@ -240,9 +240,12 @@ class MapStore {
   // batch that makes a constant cell vary is not seen by it.
   virtual absl::StatusOr<BoxSeries> PlanBoxSeries(const CellBox& box, double t,
                                                   const PredictOptions& options) const = 0;
-  // out[i] = p(t) of the plan's varying cell i, bit for bit what PredictBox gives it at t; one
-  // phasor table, spread over the shards like PredictBox. `out` is resized to the varying cells.
-  virtual void PredictBoxSeries(const BoxSeries& plan, double t, std::vector<float>& out) const = 0;
+  // out[g * n + i] = p(times[g]) of the plan's varying cell i (n of them), bit for bit what
+  // PredictBox gives it at times[g]; one phasor table a time, spread over the shards like
+  // PredictBox. A few times in one call read each model record once for all of them. `out` is
+  // resized to times.size() × n.
+  virtual void PredictBoxSeries(const BoxSeries& plan, std::span<const double> times,
+                                std::vector<float>& out) const = 0;
   virtual std::optional<StateSnapshot> Snapshot(uint64_t key) const = 0;
   // observed[i]: whether keys[i] was ever observed.
   virtual std::vector<uint8_t> Observed(std::span<const uint64_t> keys) const = 0;
