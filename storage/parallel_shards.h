@@ -1,8 +1,11 @@
-// ParallelForShards: f(shard) for every shard at once, on fresh threads (the caller's thread takes
-// shard 0), returning when all are done. For the work of callers other than the map's writer —
-// a large box query, the checkpoint's shard writes — which may run concurrently with the writer and
-// with each other; the writer's own per-shard work runs on the shards' owner threads instead
-// (ShardWorkers), which keeps every shard's tables written by one thread.
+// ParallelForShards: f(shard) for every shard, spread over the caller's thread (which takes shard 0)
+// and a process-wide pool of helper threads, returning when all are done. For the work of callers
+// other than the map's writer — a large box query, a batched Predict, the checkpoint's shard
+// writes — which may run concurrently with the writer and with each other; the writer's own
+// per-shard work runs on the shards' owner threads instead (ShardWorkers), which keeps every
+// shard's tables written by one thread. Shards run at once when helpers are free; a shard no
+// helper has taken when the caller is done with its own runs on the caller, so a call never waits
+// on a busy helper.
 // Thread-safety: reentrant; f must be safe to run on different shards at once.
 #pragma once
 
