@@ -113,6 +113,40 @@ TEST(CompactModelsTest, PredictRecordsEqualsPredictRegionOfEachRecord) {
   PredictRecords(f.models, {}, table, -1, nullptr);  // nothing listed: nothing read or written
 }
 
+// A block of records whose highest own order is below L runs the loop of that order: every state
+// still predicts exactly as at its own order, whether the block's orders are all the same (all 2 of
+// L = 5) or mixed below a low maximum, and whatever the block's size.
+TEST(CompactModelsTest, BlocksOfLowOrdersPredictEachStateAtItsOwnOrder) {
+  const PeriodSet periods = PeriodSet::Default();
+  const auto spectra = testing::RandomCellSpectra(periods, 600, 5);
+  const PhasorTable table(periods, 1.7e9 + 4321);
+  for (int highest = 0; highest <= kL; ++highest) {
+    for (bool mixed : {false, true}) {
+      CompactModels models(kL);
+      models.Resize(spectra.size());
+      std::vector<int> own(spectra.size());
+      for (size_t i = 0; i < spectra.size(); ++i) {
+        own[i] = mixed ? static_cast<int>(i % (highest + 1)) : highest;
+        models.Set(i, PublishedModel::FromSpectrum(spectra[i], periods, kL, own[i]));
+      }
+      std::vector<float> p(spectra.size()), at_order(spectra.size());
+      PredictRegion(models, table, -1, p.data());
+      std::vector<uint32_t> records(spectra.size());
+      for (uint32_t i = 0; i < records.size(); ++i) records[i] = i;
+      std::vector<float> listed(records.size());
+      PredictRecords(models, records, table, -1, listed.data());
+      for (int order = 0; order <= highest; ++order) {
+        PredictRegion(models, table, order, at_order.data());
+        for (size_t i = 0; i < spectra.size(); ++i) {
+          if (own[i] != order) continue;
+          ASSERT_EQ(p[i], at_order[i]) << "record " << i << " of own order " << order << ", highest " << highest;
+          ASSERT_EQ(listed[i], at_order[i]) << "record " << i << " of own order " << order;
+        }
+      }
+    }
+  }
+}
+
 TEST(CompactModelsTest, HigherMaxOrdersUseTheGenericKernel) {
   const PeriodSet periods = PeriodSet::Default();
   constexpr int kBigL = 12;
