@@ -409,6 +409,25 @@ TEST_F(FremenctlTest, BenchRunsTheIngestLoadGeneratorAgainstTheDaemon) {
   EXPECT_NE(Run({"bench", "ingest", "--", "--streams", "0"}).exit_code, 0);
 }
 
+TEST_F(FremenctlTest, BenchQueryMeasuresRegionsNextToTheirCeilingOfTheSameRun) {
+  // A small map: 64² cells, two days of scans, two boxes of each output, no series, no Predict.
+  RunResult r = Run({"bench", "query", "--", "--create", "--size=64", "--scans=8", "--region-reps=2",
+                     "--series-reps=0", "--predict-calls=0"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Each output's figure, then the same box of the empty map made beside it, then their ratio.
+  for (const char* output : {"FLOAT", "UINT8"}) {
+    EXPECT_THAT(r.out, HasSubstr(std::string("PredictRegion ") + output + " median"));
+    EXPECT_THAT(r.out, HasSubstr(std::string("ceiling, the same box with nothing observed: PredictRegion ") + output));
+  }
+  EXPECT_THAT(r.out, HasSubstr("of the ceiling's rate"));
+  auto filled = client_->GetMapStats("bench");
+  ASSERT_TRUE(filled.ok()) << filled.status();
+  EXPECT_EQ(filled->states(), 64u * 64u);
+  auto empty = client_->GetMapStats("bench-unobserved");
+  ASSERT_TRUE(empty.ok()) << empty.status();
+  EXPECT_EQ(empty->states(), 0u);
+}
+
 TEST_F(FremenctlTest, UnreachableDaemonSaysToStartItOrFixTheAddress) {
   const std::string nowhere = FreeLoopbackAddress();
   // The option after the subcommand wins over FREMEN_ADDRESS.

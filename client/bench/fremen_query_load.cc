@@ -1,7 +1,9 @@
 // fremen_query_load: measures QueryService as a C++ client sees it (targets: docs/performance.md,
 // "Targets") and prints medians:
 //   - PredictRegion of a box (default 1000×1000 = 1M cells) delivered as FLOAT and as UINT8:
-//     seconds per box and cells/s (target ≥ 100M cells/s);
+//     seconds per box and cells/s (targets ≥ 800M cells/s as UINT8, ≥ 300M as FLOAT), each next to
+//     its ceiling of the same run: the same box of a map where nothing was observed (made by
+//     --create), i.e. the answer's path without the prediction;
 //   - PredictRegionSeries of the same box at --series-times times (default 96: a day every 15
 //     minutes) as FLOAT and UINT8: seconds per call, delivered cell-predictions/s (cells × times /
 //     seconds) and the values and bytes on the wire, next to two ceilings of the same run: the box
@@ -11,8 +13,9 @@
 //     p99 ≤ 1 ms) and the sustained rate, with one and with several calls in flight on one channel,
 //     and the rate of predictions when each call asks for many states (the original FremenServer:
 //     ~80k predictions/s).
-// Against a running fremend. With --create it first creates a grid map and fills it through the
-// IngestService (a dense patch per scan: walls, free space and 1/8 of the cells on a daily rhythm),
+// Against a running fremend. With --create it first creates a grid map (and the ceiling's empty
+// one, "<map>-unobserved") and fills it through the IngestService (a dense patch per scan: walls,
+// free space and 1/8 of the cells on a daily rhythm),
 // running the update job through the AdminService after each simulated day, as the nightly job
 // would, so that dynamic cells hold published models whose orders were chosen on evidence.
 // Without those services, prepare a map another way (see client/bench/README.md).
@@ -125,9 +128,9 @@ class Bench {
         admin_(v1::AdminService::NewStub(channel_)),
         query_(v1::QueryService::NewStub(channel_)) {}
 
-  // A context naming the map (for proxies) and carrying the token.
-  void Prepare(grpc::ClientContext& context) const {
-    context.AddMetadata("x-fremen-map", o_.map);
+  // A context naming the map (for proxies; o_.map unless another is named) and carrying the token.
+  void Prepare(grpc::ClientContext& context, const std::string& map = "") const {
+    context.AddMetadata("x-fremen-map", map.empty() ? o_.map : map);
     if (!o_.token.empty()) context.AddMetadata("authorization", "Bearer " + o_.token);
   }
 
@@ -137,7 +140,16 @@ class Bench {
     double seconds = 0;
     uint64_t wire_bytes = 0;
   };
-  RegionRun Region(v1::RegionOutput output, const char* name);
+  // `map`: o_.map, or the ceiling map (CeilingMap()) for the ceiling of the same box.
+  RegionRun Region(v1::RegionOutput output, const char* name, const std::string& map);
+  // The regions' ceiling: the same box of a grid of the same size where nothing was observed, so
+  // that the daemon predicts nothing (every cell is 0.5) and what is left is the path of the answer
+  // — the block's fill, its encoding, serialisation, the loopback, the client's parse. Made by
+  // --create beside the filled map.
+  std::string CeilingMap() const { return o_.map + "-unobserved"; }
+  bool CreateGrid(const std::string& name);
+  // The ceiling's figures beside `run` (the filled map's), when the ceiling map exists.
+  void RegionCeiling(v1::RegionOutput output, const char* name, const RegionRun& run);
   // `single`: the same box's PredictRegion, for the ceilings.
   void RegionSeries(v1::RegionOutput output, const char* name, const RegionRun& single);
   void Predict();
@@ -179,12 +191,12 @@ class Bench {
   std::unique_ptr<v1::QueryService::Stub> query_;
 };
 
-bool Bench::CreateAndFill() {
+bool Bench::CreateGrid(const std::string& name) {
   grpc::ClientContext context;
-  Prepare(context);
+  Prepare(context, name);
   v1::CreateMapRequest request;
   v1::Map& map = *request.mutable_map();
-  map.set_name(o_.map);
+  map.set_name(name);
   map.set_kind(v1::MAP_KIND_GRID);
   map.mutable_grid()->set_resolution(0.05);
   map.mutable_grid()->mutable_size()->set_x(o_.size);
@@ -192,9 +204,14 @@ bool Bench::CreateAndFill() {
   v1::CreateMapResponse response;
   const grpc::Status status = maps_->CreateMap(&context, request, &response);
   if (!status.ok()) {
-    std::fprintf(stderr, "CreateMap %s: %s\n", o_.map.c_str(), status.error_message().c_str());
+    std::fprintf(stderr, "CreateMap %s: %s\n", name.c_str(), status.error_message().c_str());
     return false;
   }
+  return true;
+}
+
+bool Bench::CreateAndFill() {
+  if (!CreateGrid(o_.map) || !CreateGrid(CeilingMap())) return false;
   const uint32_t per_day = std::max(1u, static_cast<uint32_t>(std::lround(86400 / o_.scan_interval)));
   const auto start = Clock::now();
   for (uint32_t first = 0; first < o_.scans; first += per_day) {
@@ -280,9 +297,9 @@ bool Bench::Update() {
   return true;
 }
 
-Bench::RegionRun Bench::Region(v1::RegionOutput output, const char* name) {
+Bench::RegionRun Bench::Region(v1::RegionOutput output, const char* name, const std::string& map) {
   v1::PredictRegionRequest request;
-  request.set_map(o_.map);
+  request.set_map(map);
   request.mutable_hi()->set_x(o_.size);
   request.mutable_hi()->set_y(o_.size);
   request.set_time(kT0 + o_.scan_interval * o_.scans + 3600);
@@ -292,7 +309,7 @@ Bench::RegionRun Bench::Region(v1::RegionOutput output, const char* name) {
   uint64_t wire_bytes = 0;
   for (int rep = 0; rep < o_.region_reps; ++rep) {
     grpc::ClientContext context;
-    Prepare(context);
+    Prepare(context, map);
     const auto start = Clock::now();
     auto reader = query_->PredictRegion(&context, request);
     v1::PredictRegionResponse chunk;
@@ -305,19 +322,40 @@ Bench::RegionRun Bench::Region(v1::RegionOutput output, const char* name) {
     }
     const grpc::Status status = reader->Finish();
     if (!status.ok() || received != cells) {
-      std::fprintf(stderr, "PredictRegion %s: %s (%llu of %llu cells)\n", name, status.error_message().c_str(),
-                   static_cast<unsigned long long>(received), static_cast<unsigned long long>(cells));
+      std::fprintf(stderr, "PredictRegion %s of %s: %s (%llu of %llu cells)\n", name, map.c_str(),
+                   status.error_message().c_str(), static_cast<unsigned long long>(received),
+                   static_cast<unsigned long long>(cells));
       return {};
     }
     seconds.push_back(Seconds(Clock::now() - start));
-    if (rep == 0) std::printf("PredictRegion %-5s %llu cells in %llu chunks\n", name,
-                              static_cast<unsigned long long>(cells), static_cast<unsigned long long>(chunks));
+    if (rep == 0 && map == o_.map) {
+      std::printf("PredictRegion %-5s %llu cells in %llu chunks\n", name, static_cast<unsigned long long>(cells),
+                  static_cast<unsigned long long>(chunks));
+    }
   }
   const double median = Median(seconds);
-  std::printf("PredictRegion %-5s median %.2f ms per box = %.1fM cells/s (best %.2f ms), %.0f MB/s on the wire\n",
-              name, median * 1e3, static_cast<double>(cells) / median / 1e6,
-              *std::min_element(seconds.begin(), seconds.end()) * 1e3, wire_bytes / median / 1e6);
+  std::printf("%sPredictRegion %-5s median %.2f ms per box = %.1fM cells/s (best %.2f ms), %.0f MB/s on the wire\n",
+              map == o_.map ? "" : "  ceiling, the same box with nothing observed: ", name, median * 1e3,
+              static_cast<double>(cells) / median / 1e6, *std::min_element(seconds.begin(), seconds.end()) * 1e3,
+              wire_bytes / median / 1e6);
   return {median, wire_bytes};
+}
+
+void Bench::RegionCeiling(v1::RegionOutput output, const char* name, const RegionRun& run) {
+  if (run.seconds == 0) return;
+  grpc::ClientContext context;
+  Prepare(context, CeilingMap());
+  v1::GetMapRequest request;
+  request.set_map(CeilingMap());
+  v1::GetMapResponse map;
+  if (!maps_->GetMap(&context, request, &map).ok()) {
+    std::printf("  (no ceiling: map %s is missing; --create makes it)\n", CeilingMap().c_str());
+    return;
+  }
+  const RegionRun ceiling = Region(output, name, CeilingMap());
+  if (ceiling.seconds > 0) {
+    std::printf("  the filled map's box at %.0f%% of the ceiling's rate\n", 100 * ceiling.seconds / run.seconds);
+  }
 }
 
 void Bench::RegionSeries(v1::RegionOutput output, const char* name, const RegionRun& single) {
@@ -554,8 +592,10 @@ int main(int argc, char** argv) {
   // A count of 0 leaves its part out (e.g. --series-reps=0 --predict-calls=0: regions only, for
   // profiling the daemon); the series' ceilings need the regions.
   if (!options.batched_only && options.region_reps > 0) {
-    const auto floats = bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT");
-    const auto bytes = bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8");
+    const auto floats = bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT", options.map);
+    bench.RegionCeiling(v1::REGION_OUTPUT_FLOAT, "FLOAT", floats);
+    const auto bytes = bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8", options.map);
+    bench.RegionCeiling(v1::REGION_OUTPUT_UINT8, "UINT8", bytes);
     if (options.series_reps > 0) {
       bench.RegionSeries(v1::REGION_OUTPUT_FLOAT, "FLOAT", floats);
       bench.RegionSeries(v1::REGION_OUTPUT_UINT8, "UINT8", bytes);
