@@ -53,6 +53,29 @@ TEST(CompactModelsTest, RecordIs60BytesAtOrder5AndRoundTrips) {
   EXPECT_EQ(fresh.header(0).alpha0, 0.5f);
 }
 
+// published(i) is read from a bit kept beside the records: it follows the header's flag through
+// Set, SetUnpublished, MarkPublished, a shrink and a growth.
+TEST(CompactModelsTest, ThePublishedBitFollowsEveryWriteOfTheRecord) {
+  Fixture f(300);
+  const auto agree = [&](const char* after) {
+    for (size_t i = 0; i < f.models.size(); ++i) {
+      ASSERT_EQ(f.models.published(i), f.models.header(i).published != 0) << "record " << i << " after " << after;
+    }
+  };
+  agree("the fixture");
+  for (size_t i = 0; i < 300; i += 3) f.models.SetUnpublished(i, 0.25f);
+  agree("SetUnpublished");
+  for (size_t i = 1; i < 300; i += 5) f.models.MarkPublished(i);
+  agree("MarkPublished");
+  f.models.Set(0, f.published[1]);
+  EXPECT_TRUE(f.models.published(0));
+  f.models.Resize(130);  // keeps 0..129; 128 and 129 share their word with the dropped ones
+  agree("the shrink");
+  f.models.Resize(400);
+  agree("the growth");
+  for (size_t i = 130; i < 400; ++i) EXPECT_FALSE(f.models.published(i)) << "new record " << i;
+}
+
 TEST(CompactModelsTest, PredictAllOrdersEqualsThePublishedModel) {
   const Fixture f(200);
   for (double t : {1.7e9, 1.7e9 + 12345.6, 1.7e9 + 5e5}) {

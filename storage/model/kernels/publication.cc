@@ -63,8 +63,8 @@ void Publisher::Publish(const CompactSpectrum& spectrum, int order, CompactModel
   // rewriting γ_k = S̄_k − γ0·Ē_k here would be free to round differently (the compiler may fuse the
   // product into the subtraction in one place and not in the other), and publication must be exact.
   models.SetUnpublished(out, static_cast<float>(spectrum.gamma0()));
+  models.MarkPublished(out);
   CompactModelHeader& h = models.header(out);
-  h.published = 1;
   h.order = static_cast<uint8_t>(order);
   if (spectrum.count() == 0 || max_order_ == 0) return;
 
