@@ -12,21 +12,34 @@
 //
 // Handles as the shard keeps them: kNoHandle (unobserved), kNeverChanged | value, or a dynamic
 // state's index (top bit clear).
+//
+// The box's array holds p as float, or quantised as bytes (CellValue<uint8_t>, the UINT8 region
+// output), so that a UINT8 region is written once, in its wire form, rather than as floats first.
 #pragma once
 
 #include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
 #include "storage/cell_key.h"
+#include "storage/model/kernels/region_predict.h"
 #include "storage/queries.h"
 
 namespace fremen::storage {
+
+// p as a cell of a box of T: the float itself, or its byte round(255·p).
+template <typename T>
+T CellValue(float p);
+template <>
+inline float CellValue<float>(float p) { return p; }
+template <>
+inline uint8_t CellValue<uint8_t>(float p) { return model::QuantizeProbability(p); }
 
 class BrickRegion {
  public:
@@ -41,11 +54,11 @@ class BrickRegion {
   int64_t offset(uint32_t i) const { return offset_[i]; }
 
   // Writes p of each never-changed and each unobserved cell of a whole brick, whose first cell is
-  // at `origin` in the box, and calls on_dynamic(handle, float* cell) for each other cell, in
-  // handle order. The dynamic cells' values are left for the caller to write.
+  // at `origin` in the box, and calls on_dynamic(handle, T* cell) for each other cell, in handle
+  // order. The dynamic cells' values are left for the caller to write. T: float or uint8_t.
   // REQUIRES: the whole brick is inside the box.
-  template <typename OnDynamic>
-  void Write(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const {
+  template <typename T, typename OnDynamic>
+  void Write(const uint32_t* handles, T* origin, OnDynamic on_dynamic) const {
 #if defined(__SSE2__)  // every x86-64
     WriteSixteenAtATime(handles, origin, on_dynamic);
 #else
@@ -55,23 +68,35 @@ class BrickRegion {
 
   // Write's two ways, the same result: public so that the tests compare both with the cell by cell
   // walk on any machine that has SSE2.
-  template <typename OnDynamic>
-  void WriteEachCell(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const {
+  template <typename T, typename OnDynamic>
+  void WriteEachCell(const uint32_t* handles, T* origin, OnDynamic on_dynamic) const {
     for (uint32_t i = 0; i < 512; ++i) {
       const uint32_t h = handles[i];
       if (h & kNeverChanged) {
-        origin[offset_[i]] = h == kNoHandle ? kUnobservedProbability : static_cast<float>(h & 1u);
+        origin[offset_[i]] = CellValue<T>(h == kNoHandle ? kUnobservedProbability : static_cast<float>(h & 1u));
       } else {
         on_dynamic(h, origin + offset_[i]);
       }
     }
   }
 #if defined(__SSE2__)
-  template <typename OnDynamic>
-  void WriteSixteenAtATime(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const;
+  template <typename T, typename OnDynamic>
+  void WriteSixteenAtATime(const uint32_t* handles, T* origin, OnDynamic on_dynamic) const;
 #endif
 
  private:
+#if defined(__SSE2__)
+  // Four cells of a row, p in each lane.
+  static void StoreRow(float* cells, __m128 p) { _mm_storeu_ps(cells, p); }
+  // As four bytes: round(255·p) as QuantizeProbability makes it (p·255 + 0.5 truncated).
+  static void StoreRow(uint8_t* cells, __m128 p) {
+    const __m128i q = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(p, _mm_set1_ps(255.0f)), _mm_set1_ps(0.5f)));
+    const __m128i halves = _mm_packs_epi32(q, q);
+    const int32_t four = _mm_cvtsi128_si32(_mm_packus_epi16(halves, halves));
+    std::memcpy(cells, &four, sizeof(four));
+  }
+#endif
+
   // Handle index of the first cell of row r (0..3) of a group of sixteen, relative to the group's
   // first: rows 0, 1 are lanes 0 and 2 of the first four handles; rows 2, 3 the same lanes of the
   // four handles that hold the other half of the block (the next y pair of a flat brick, z + 1 of
@@ -82,8 +107,8 @@ class BrickRegion {
 };
 
 #if defined(__SSE2__)
-template <typename OnDynamic>
-void BrickRegion::WriteSixteenAtATime(const uint32_t* handles, float* origin, OnDynamic on_dynamic) const {
+template <typename T, typename OnDynamic>
+void BrickRegion::WriteSixteenAtATime(const uint32_t* handles, T* origin, OnDynamic on_dynamic) const {
   const __m128i none = _mm_set1_epi32(-1), bit = _mm_set1_epi32(1);
   const __m128 unobserved = _mm_set1_ps(kUnobservedProbability);
   for (uint32_t g = 0; g < 512; g += 16) {
@@ -99,10 +124,10 @@ void BrickRegion::WriteSixteenAtATime(const uint32_t* handles, float* origin, On
     // Flat (x0 y0 x1 y1): v[1] is v[0] at x + 2, v[3] is v[2] at x + 2. Cubic (x0 y0 z0 x1): v[2]
     // is v[0] at x + 2, v[3] is v[1] at x + 2.
     const __m128 a = v[0], b = flat_ ? v[1] : v[2], c = flat_ ? v[2] : v[1], d = v[3];
-    _mm_storeu_ps(origin + offset_[g + row_start_[0]], _mm_movelh_ps(a, b));
-    _mm_storeu_ps(origin + offset_[g + row_start_[1]], _mm_movehl_ps(b, a));
-    _mm_storeu_ps(origin + offset_[g + row_start_[2]], _mm_movelh_ps(c, d));
-    _mm_storeu_ps(origin + offset_[g + row_start_[3]], _mm_movehl_ps(d, c));
+    StoreRow(origin + offset_[g + row_start_[0]], _mm_movelh_ps(a, b));
+    StoreRow(origin + offset_[g + row_start_[1]], _mm_movehl_ps(b, a));
+    StoreRow(origin + offset_[g + row_start_[2]], _mm_movelh_ps(c, d));
+    StoreRow(origin + offset_[g + row_start_[3]], _mm_movehl_ps(d, c));
     for (uint32_t dynamic = ~never_changed_or_none & 0xffffu; dynamic != 0; dynamic &= dynamic - 1) {
       const uint32_t i = g + static_cast<uint32_t>(std::countr_zero(dynamic));
       on_dynamic(handles[i], origin + offset_[i]);

@@ -10,11 +10,13 @@ namespace fremen::storage {
 namespace {
 
 // A brick of random handles (unobserved, never changed at 0 or 1, dynamic) written into a box
-// larger than the brick, at an offset inside it: every cell of the brick must hold what the cell
-// by cell walk gives, every dynamic cell must be reported once with its handle and its place, and
-// no cell outside the brick may be touched.
+// larger than the brick, at an offset inside it, as floats or as bytes: every cell of the brick
+// must hold what the cell by cell walk gives (as a byte, its QuantizeProbability), every dynamic
+// cell must be reported once with its handle and its place, and no cell outside the brick may be
+// touched.
 enum class Way { kEachCell, kSixteenAtATime };
 
+template <typename T>
 void CheckAgainstCellByCell(const GridKeys& keys, Way way, uint64_t seed) {
   const std::array<uint32_t, 3> bs = keys.brick_size();
   const uint64_t nx = bs[0] + 5, ny = bs[1] + 3, nz = bs[2] + 2;
@@ -29,12 +31,12 @@ void CheckAgainstCellByCell(const GridKeys& keys, Way way, uint64_t seed) {
       default: h = static_cast<uint32_t>(rng() % 1000000); break;  // a dynamic index
     }
   }
-  constexpr float kUntouched = -7.0f;
-  std::vector<float> box(nx * ny * nz, kUntouched);
+  const T kUntouched = static_cast<T>(77);  // neither 0, 0.5, 1 nor their bytes 0, 128, 255
+  std::vector<T> box(nx * ny * nz, kUntouched);
   const BrickRegion region(keys, nx, ny);
-  float* origin = box.data() + (at[2] * ny + at[1]) * nx + at[0];
-  std::map<const float*, uint32_t> reported;
-  const auto report = [&](uint32_t handle, float* cell) {
+  T* origin = box.data() + (at[2] * ny + at[1]) * nx + at[0];
+  std::map<const T*, uint32_t> reported;
+  const auto report = [&](uint32_t handle, T* cell) {
     EXPECT_TRUE(reported.emplace(cell, handle).second) << "a dynamic cell reported twice";
   };
   if (way == Way::kEachCell) {
@@ -48,7 +50,7 @@ void CheckAgainstCellByCell(const GridKeys& keys, Way way, uint64_t seed) {
   for (uint64_t z = 0; z < nz; ++z) {
     for (uint64_t y = 0; y < ny; ++y) {
       for (uint64_t x = 0; x < nx; ++x) {
-        const float* cell = &box[(z * ny + y) * nx + x];
+        const T* cell = &box[(z * ny + y) * nx + x];
         const bool inside = x >= at[0] && x < at[0] + bs[0] && y >= at[1] && y < at[1] + bs[1] &&
                             z >= at[2] && z < at[2] + bs[2];
         if (!inside) {
@@ -60,9 +62,9 @@ void CheckAgainstCellByCell(const GridKeys& keys, Way way, uint64_t seed) {
         ASSERT_EQ(cell, origin + region.offset(i));
         const uint32_t h = handles[i];
         if (h == BrickRegion::kNoHandle) {
-          ASSERT_EQ(*cell, kUnobservedProbability) << x << "," << y << "," << z;
+          ASSERT_EQ(*cell, CellValue<T>(kUnobservedProbability)) << x << "," << y << "," << z;
         } else if (h & BrickRegion::kNeverChanged) {
-          ASSERT_EQ(*cell, static_cast<float>(h & 1u)) << x << "," << y << "," << z;
+          ASSERT_EQ(*cell, CellValue<T>(static_cast<float>(h & 1u))) << x << "," << y << "," << z;
         } else {
           ++dynamic;
           const auto it = reported.find(cell);
@@ -78,18 +80,30 @@ void CheckAgainstCellByCell(const GridKeys& keys, Way way, uint64_t seed) {
 
 // Write takes the sixteen-at-a-time way on x86-64 (SSE2) and the cell-by-cell way elsewhere; both
 // are checked here wherever they compile.
-TEST(BrickRegionTest, FlatBrickEqualsTheCellByCellWalk) {
-  for (uint64_t seed = 1; seed <= 20; ++seed) CheckAgainstCellByCell(GridKeys::For(1), Way::kEachCell, seed);
+template <typename T>
+void CheckBothWays(const GridKeys& keys) {
+  for (uint64_t seed = 1; seed <= 20; ++seed) CheckAgainstCellByCell<T>(keys, Way::kEachCell, seed);
 #if defined(__SSE2__)
-  for (uint64_t seed = 1; seed <= 20; ++seed) CheckAgainstCellByCell(GridKeys::For(1), Way::kSixteenAtATime, seed);
+  for (uint64_t seed = 1; seed <= 20; ++seed) CheckAgainstCellByCell<T>(keys, Way::kSixteenAtATime, seed);
 #endif
 }
 
+TEST(BrickRegionTest, FlatBrickEqualsTheCellByCellWalk) {
+  CheckBothWays<float>(GridKeys::For(1));
+  CheckBothWays<uint8_t>(GridKeys::For(1));
+}
+
 TEST(BrickRegionTest, CubicBrickEqualsTheCellByCellWalk) {
-  for (uint64_t seed = 1; seed <= 20; ++seed) CheckAgainstCellByCell(GridKeys::For(8), Way::kEachCell, seed);
-#if defined(__SSE2__)
-  for (uint64_t seed = 1; seed <= 20; ++seed) CheckAgainstCellByCell(GridKeys::For(8), Way::kSixteenAtATime, seed);
-#endif
+  CheckBothWays<float>(GridKeys::For(8));
+  CheckBothWays<uint8_t>(GridKeys::For(8));
+}
+
+// A byte is round(255·p): 0, 128 (an unobserved cell's 0.5) and 255.
+TEST(BrickRegionTest, BytesAreTheQuantisedProbabilities) {
+  EXPECT_EQ(CellValue<uint8_t>(0.0f), 0);
+  EXPECT_EQ(CellValue<uint8_t>(kUnobservedProbability), 128);
+  EXPECT_EQ(CellValue<uint8_t>(1.0f), 255);
+  EXPECT_EQ(CellValue<float>(0.25f), 0.25f);
 }
 
 }  // namespace

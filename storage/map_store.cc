@@ -17,6 +17,7 @@
 #include "absl/strings/strip.h"
 #include "absl/strings/ascii.h"
 #include "absl/time/clock.h"
+#include "storage/brick_region.h"
 #include "storage/cell_key.h"
 #include "storage/parallel_shards.h"
 
@@ -1020,13 +1021,24 @@ absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const Predic
 
 absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
                                   std::span<float> out) const {
+  return PredictBoxInto(box, t, options, out);
+}
+
+absl::Status MapStoreImpl::PredictBox(const CellBox& box, double t, const PredictOptions& options,
+                                  std::span<uint8_t> out) const {
+  return PredictBoxInto(box, t, options, out);
+}
+
+template <typename T>
+absl::Status MapStoreImpl::PredictBoxInto(const CellBox& box, double t, const PredictOptions& options,
+                                          std::span<T> out) const {
   if (absl::Status s = CheckBox(box); !s.ok()) return s;
   if (out.size() != box.cell_count()) {
     return absl::InvalidArgumentError(
         absl::StrCat("out holds ", out.size(), " values for a box of ", box.cell_count(), " cells"));
   }
   const model::PhasorTable table(settings_->periods, t);
-  std::fill(out.begin(), out.end(), kUnobservedProbability);
+  std::fill(out.begin(), out.end(), CellValue<T>(kUnobservedProbability));
   ParallelForShards(
       shards_.size(), [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); },
       /*parallel=*/box.cell_count() >= (1u << 16));

@@ -61,6 +61,8 @@ class MapStoreImpl final : public MapStore {
                           std::vector<float>& out) const override;
   absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
                           std::span<float> out) const override;
+  absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
+                          std::span<uint8_t> out) const override;
   absl::StatusOr<BoxSeries> PlanBoxSeries(const CellBox& box, double t, const PredictOptions& options) const override;
   void PredictBoxSeries(const BoxSeries& plan, std::span<const double> times, std::vector<float>& out) const override;
   std::optional<StateSnapshot> Snapshot(uint64_t key) const override;
@@ -182,6 +184,9 @@ class MapStoreImpl final : public MapStore {
   // From this many keys a time, Predict asks the shards at once, each on its own thread (as
   // PredictBox does from 2^16 cells): below it a thread's start costs more than it saves.
   static constexpr size_t kParallelPredictions = size_t{1} << 16;
+  // PredictBox into the caller's floats or bytes.
+  template <typename T>
+  absl::Status PredictBoxInto(const CellBox& box, double t, const PredictOptions& options, std::span<T> out) const;
 
   const MapInfo info_;
   const std::string dir_;

@@ -1,13 +1,15 @@
 // MapStore::PredictBox over boxes that hold whole bricks (BrickRegion's sixteen-at-a-time path)
-// and parts of bricks (the cell-by-cell walk): every cell must be what a point prediction gives,
-// for a flat and a cubic grid, with never-changed cells at 0 and at 1, unobserved cells, and
-// dynamic ones with and without a published model.
+// and parts of bricks (the cell-by-cell walk), as floats and as bytes: every cell must be what a
+// point prediction gives (a byte, its quantisation), for a flat and a cubic grid, with
+// never-changed cells at 0 and at 1, unobserved cells, and dynamic ones with and without a
+// published model.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "storage/map_store.h"
+#include "storage/model/kernels/region_predict.h"
 #include "storage/testing/open_map_store.h"
 #include "storage/testing/scans.h"
 #include "testing/temp_dir.h"
@@ -68,6 +70,9 @@ void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& bo
     std::vector<float> region;
     ASSERT_TRUE(store->PredictBox(box, t, {}, region).ok());
     ASSERT_EQ(region.size(), box.cell_count());
+    // The same box as bytes (the UINT8 region), quantised by the shards as they write.
+    std::vector<uint8_t> bytes(box.cell_count(), 77);
+    ASSERT_TRUE(store->PredictBox(box, t, {}, std::span<uint8_t>(bytes)).ok());
     size_t i = 0;
     size_t kinds[4] = {};  // unobserved, never changed at 0, at 1, dynamic
     for (uint32_t z = box.lo[2]; z < box.hi[2]; ++z) {
@@ -76,6 +81,7 @@ void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& bo
           const uint64_t key = map.grid.keys().Key(x, y, z);
           const double times[] = {t};
           ASSERT_EQ(region[i], store->Predict({&key, 1}, times, {})[0]) << x << "," << y << "," << z;
+          ASSERT_EQ(bytes[i], model::QuantizeProbability(region[i])) << x << "," << y << "," << z;
           const auto snapshot = store->Snapshot(key);
           ++kinds[!snapshot ? 0 : !snapshot->is_static ? 3 : snapshot->static_state.value() == 1.0f ? 2 : 1];
         }

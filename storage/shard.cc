@@ -580,8 +580,9 @@ void Shard::PredictBoxConstant(const CellBox& box, const model::PhasorTable& tab
 // PredictRegion's hot path keeps its own loop: sharing PredictBoxConstant's brick walk
 // (ForEachBoxCell) made a 1M-cell UINT8 region's median 1.4-1.7x slower (fremen_query_load, two
 // pairs interleaved with main's fremend).
+template <typename T>
 void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                       float* out) const {
+                       T* out) const {
   if (box.cell_count() == 0) return;
   base::ReaderMutexLock lock(&mutex_);
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
@@ -595,7 +596,7 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   // their way (a miss per dynamic cell, one after another, and one per line of a brick's handles
   // were most of a 1M-cell region's samples).
   std::array<uint32_t, 512> dynamic, published;
-  std::array<float*, 512> dynamic_cells, published_cells;
+  std::array<T*, 512> dynamic_cells, published_cells;
   std::array<float, 512> predicted;
   // A brick wholly in the box goes sixteen cells at a time (BrickRegion), one partly in it cell by
   // cell.
@@ -609,9 +610,9 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
     size_t m = 0;
     if (c.hi[0] - c.lo[0] == bs[0] && c.hi[1] - c.lo[1] == bs[1] && c.hi[2] - c.lo[2] == bs[2]) {
       if (!whole_bricks) whole_bricks.emplace(grid_keys_, nx, ny);
-      float* origin = out + ((c.lo[2] - box.lo[2]) * ny + (c.lo[1] - box.lo[1])) * nx + (c.lo[0] - box.lo[0]);
+      T* origin = out + ((c.lo[2] - box.lo[2]) * ny + (c.lo[1] - box.lo[1])) * nx + (c.lo[0] - box.lo[0]);
       whole_bricks->Write(brick->handles.data(), origin,
-                          [&](uint32_t handle, float* cell) ABSL_NO_THREAD_SAFETY_ANALYSIS {  // under the lock above
+                          [&](uint32_t handle, T* cell) ABSL_NO_THREAD_SAFETY_ANALYSIS {  // under the lock above
                             __builtin_prefetch(models_.record(handle));
                             dynamic[m] = handle;
                             dynamic_cells[m++] = cell;
@@ -619,13 +620,13 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
     } else {  // a part of a brick
       for (uint32_t z = c.lo[2]; z < c.hi[2]; ++z) {
         for (uint32_t y = c.lo[1]; y < c.hi[1]; ++y) {
-          float* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
+          T* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
           const uint32_t yz = walk.spread_y[y & (bs[1] - 1)] | walk.spread_z[z & (bs[2] - 1)];
           for (uint32_t x = c.lo[0]; x < c.hi[0]; ++x) {
             const uint32_t handle = brick->handles[yz | walk.spread_x[x & mask_x]];
             if (handle == kNone) continue;
             if (handle & kStaticHandle) {
-              row[x] = PredictHandle(handle, table, options);
+              row[x] = CellValue<T>(PredictHandle(handle, table, options));
             } else {
               __builtin_prefetch(models_.record(handle));
               dynamic[m] = handle;
@@ -641,13 +642,15 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
         published[n] = dynamic[i];
         published_cells[n++] = dynamic_cells[i];
       } else {
-        *dynamic_cells[i] = PredictHandle(dynamic[i], table, options);
+        *dynamic_cells[i] = CellValue<T>(PredictHandle(dynamic[i], table, options));
       }
     }
     PredictPublished({published.data(), n}, table, options, predicted.data());
-    for (size_t i = 0; i < n; ++i) *published_cells[i] = predicted[i];
+    for (size_t i = 0; i < n; ++i) *published_cells[i] = CellValue<T>(predicted[i]);
   }
 }
+template void Shard::PredictBox(const CellBox&, const model::PhasorTable&, const PredictOptions&, float*) const;
+template void Shard::PredictBox(const CellBox&, const model::PhasorTable&, const PredictOptions&, uint8_t*) const;
 
 bool Shard::Observed(uint64_t key) const {
   base::ReaderMutexLock lock(&mutex_);

@@ -137,9 +137,11 @@ class Shard {
   // p(t) of one state (kUnobservedProbability when never observed).
   float Predict(uint64_t key, const model::PhasorTable& table, const PredictOptions& options) const;
   // Writes p(t) of every cell of `box` held by this shard into out[index of the cell in the box]
-  // (x fastest, then y, then z); cells it does not hold are left as they are.
+  // (x fastest, then y, then z); cells it does not hold are left as they are. T: float, or uint8_t
+  // for p quantised (CellValue, storage/brick_region.h).
+  template <typename T>
   void PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                  float* out) const;
+                  T* out) const;
   // PredictBox's first half for a box at many times: of the cells of `box` held by this shard,
   // those whose p(t) cannot change with t under `options` (VariesWithTime) get p(t) written into
   // out[index in the box], exactly as PredictBox writes it; the others get dynamic[index] = their

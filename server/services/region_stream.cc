@@ -1,5 +1,8 @@
 #include "server/services/region_stream.h"
 
+#include <span>
+#include <string>
+
 #include "server/convert/query_args.h"
 #include "server/services/region_request.h"
 
@@ -47,10 +50,11 @@ absl::Status RegionStream::ComputeBlock(uint64_t i, Chunks& chunks, uint64_t& /*
   const RegionPlan::Chunk block = blocks_->chunk(i);
   // A block is a run of the box's cells in the box's order, and so is each chunk of the block.
   const RegionPlan plan(block.box, chunk_cells_);
-  const bool floats = output_ == v1::REGION_OUTPUT_FLOAT;
-  // Floats are predicted straight into each chunk's response; the other outputs are computed from
-  // the block's p, predicted once into scratch_.
-  if (!floats) {
+  const bool floats = output_ == v1::REGION_OUTPUT_FLOAT, bytes = output_ == v1::REGION_OUTPUT_UINT8;
+  // Floats and bytes are predicted straight into each chunk's response (bytes quantised by the
+  // shards as they write); the other outputs are computed from the block's p, predicted once into
+  // scratch_.
+  if (!floats && !bytes) {
     if (absl::Status s = map_->PredictBox(block.box, time_, options_, scratch_); !s.ok()) return s;
   }
   for (uint64_t j = 0; j < plan.chunk_count(); ++j) {
@@ -68,6 +72,12 @@ absl::Status RegionStream::ComputeBlock(uint64_t i, Chunks& chunks, uint64_t& /*
         return s;
       }
       buffer->clear_bytes_values();
+    } else if (bytes) {
+      buffer->clear_float_values();
+      std::string& values = *buffer->mutable_bytes_values();
+      values.resize(chunk.box.cell_count());
+      const std::span<uint8_t> out(reinterpret_cast<uint8_t*>(values.data()), values.size());
+      if (absl::Status s = map_->PredictBox(chunk.box, time_, options_, out); !s.ok()) return s;
     } else {
       EncodeRegionValues(output_, confidence_,
                          std::span<const float>(scratch_).subspan(chunk.offset, chunk.box.cell_count()), *buffer);

@@ -235,6 +235,10 @@ class MapStore {
   // unless out holds exactly the box's cells.
   virtual absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
                                   std::span<float> out) const = 0;
+  // The same quantised, round(255·p) a cell (model::QuantizeProbability: a UINT8 region's wire
+  // form), written by the shards as they predict: no float of the box is made.
+  virtual absl::Status PredictBox(const CellBox& box, double t, const PredictOptions& options,
+                                  std::span<uint8_t> out) const = 0;
   // A box at many times, planned once at `t` (one of the times): which cells vary with time and
   // the others' p. Errors as PredictBox's. The plan holds the models as they are now: a later
   // batch that makes a constant cell vary is not seen by it.
