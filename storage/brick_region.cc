@@ -2,6 +2,13 @@
 
 namespace fremen::storage {
 
+BoxBricks::BoxBricks(const CellBox& box, const std::array<uint32_t, 3>& brick_size) : box_(box), brick_size_(brick_size) {
+  for (int a = 0; a < 3; ++a) {
+    first_[a] = box.lo[a] / brick_size[a];
+    count_[a] = box.hi[a] > box.lo[a] ? (box.hi[a] - 1) / brick_size[a] - first_[a] + 1 : 0;
+  }
+}
+
 BrickRegion::BrickRegion(const GridKeys& keys, uint64_t nx, uint64_t ny) : flat_(keys.flat()) {
   const std::array<uint32_t, 3> bs = keys.brick_size();
   for (uint32_t z = 0; z < bs[2]; ++z) {

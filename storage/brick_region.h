@@ -17,6 +17,7 @@
 // output), so that a UINT8 region is written once, in its wire form, rather than as floats first.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstddef>
@@ -40,6 +41,59 @@ template <>
 inline float CellValue<float>(float p) { return p; }
 template <>
 inline uint8_t CellValue<uint8_t>(float p) { return model::QuantizeProbability(p); }
+
+// The bricks a box overlaps, numbered as a grid of their own (x fastest): which of them some shard
+// holds, so that a box's cells in no brick of any shard — and only those — are filled with the
+// unobserved value (MapStoreImpl::PredictBox), not every cell first.
+class BoxBricks {
+ public:
+  BoxBricks(const CellBox& box, const std::array<uint32_t, 3>& brick_size);
+
+  size_t size() const { return size_t{count_[0]} * count_[1] * count_[2]; }
+  // The number of brick (bx, by, bz) of the grid (in bricks), which the box overlaps.
+  size_t Index(uint32_t bx, uint32_t by, uint32_t bz) const {
+    return (size_t{bz - first_[2]} * count_[1] + (by - first_[1])) * count_[0] + (bx - first_[0]);
+  }
+  // Sets every cell of the box that lies in a brick i with held[i] == 0 to `value`; `out` is the
+  // box's row-major array.
+  template <typename T>
+  void FillUnheld(const uint8_t* held, T value, T* out) const;
+
+ private:
+  CellBox box_;
+  std::array<uint32_t, 3> brick_size_, first_, count_;
+};
+
+template <typename T>
+void BoxBricks::FillUnheld(const uint8_t* held, T value, T* out) const {
+  const uint64_t nx = box_.hi[0] - box_.lo[0], ny = box_.hi[1] - box_.lo[1];
+  for (uint32_t bz = 0; bz < count_[2]; ++bz) {
+    for (uint32_t by = 0; by < count_[1]; ++by) {
+      const uint8_t* row_held = held + (size_t{bz} * count_[1] + by) * count_[0];
+      if (std::find(row_held, row_held + count_[0], 0) == row_held + count_[0]) continue;
+      const uint32_t y0 = std::max(box_.lo[1], (first_[1] + by) * brick_size_[1]);
+      const uint32_t y1 = std::min(box_.hi[1], (first_[1] + by + 1) * brick_size_[1]);
+      const uint32_t z0 = std::max(box_.lo[2], (first_[2] + bz) * brick_size_[2]);
+      const uint32_t z1 = std::min(box_.hi[2], (first_[2] + bz + 1) * brick_size_[2]);
+      for (uint32_t z = z0; z < z1; ++z) {
+        for (uint32_t y = y0; y < y1; ++y) {
+          T* row = out + ((z - box_.lo[2]) * ny + (y - box_.lo[1])) * nx - box_.lo[0];
+          // Each run of unheld bricks along x in one fill (an empty map's box: a fill per row).
+          for (uint32_t bx = 0; bx < count_[0];) {
+            if (row_held[bx]) {
+              ++bx;
+              continue;
+            }
+            const uint32_t run = bx;
+            while (bx < count_[0] && !row_held[bx]) ++bx;
+            std::fill(row + std::max(box_.lo[0], (first_[0] + run) * brick_size_[0]),
+                      row + std::min(box_.hi[0], (first_[0] + bx) * brick_size_[0]), value);
+          }
+        }
+      }
+    }
+  }
+}
 
 class BrickRegion {
  public:

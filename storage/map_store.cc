@@ -1038,10 +1038,14 @@ absl::Status MapStoreImpl::PredictBoxInto(const CellBox& box, double t, const Pr
         absl::StrCat("out holds ", out.size(), " values for a box of ", box.cell_count(), " cells"));
   }
   const model::PhasorTable table(settings_->periods, t);
-  std::fill(out.begin(), out.end(), CellValue<T>(kUnobservedProbability));
+  // The shards write every cell of their bricks; the cells of bricks none holds are filled after,
+  // rather than every cell before (a 1M-cell FLOAT box's fill was 4% of a region's daemon time).
+  const BoxBricks bricks(box, info_.grid.keys().brick_size());
+  std::vector<uint8_t> held(bricks.size(), 0);
   ParallelForShards(
-      shards_.size(), [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data()); },
+      shards_.size(), [&](size_t s) { shards_[s]->PredictBox(box, table, options, out.data(), held.data()); },
       /*parallel=*/box.cell_count() >= (1u << 16));
+  bricks.FillUnheld(held.data(), CellValue<T>(kUnobservedProbability), out.data());
   return absl::OkStatus();
 }
 

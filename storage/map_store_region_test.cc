@@ -21,9 +21,10 @@ using testing::GridMap;
 using testing::OpenOrDie;
 using fremen::testing::TempDir;
 
-// Scan i: about 3/4 of the cells (the rest stay unobserved); cells with x % 7 == 0 follow a daily
-// square wave, the others keep one value for ever, 1 where (x + 2y + z) % 3 == 0, else 0.
-ObservationBatch Scan(const MapInfo& map, uint64_t i) {
+// Scan i: about 3/4 of the cells with x < observed_x (the rest stay unobserved); cells with
+// x % 7 == 0 follow a daily square wave, the others keep one value for ever, 1 where
+// (x + 2y + z) % 3 == 0, else 0.
+ObservationBatch Scan(const MapInfo& map, uint64_t i, uint32_t observed_x) {
   ObservationBatch b;
   b.writer_id = 1;
   b.sequence = i + 1;
@@ -32,7 +33,7 @@ ObservationBatch Scan(const MapInfo& map, uint64_t i) {
   const std::array<uint32_t, 3> size = map.grid.size;
   for (uint32_t z = 0; z < size[2]; ++z) {
     for (uint32_t y = 0; y < size[1]; ++y) {
-      for (uint32_t x = 0; x < size[0]; ++x) {
+      for (uint32_t x = 0; x < std::min(size[0], observed_x); ++x) {
         if ((x * 7 + y * 13 + z * 3) % 4 != 0) b.keys.push_back(map.grid.keys().Key(x, y, z));  // else never observed
       }
     }
@@ -45,10 +46,12 @@ ObservationBatch Scan(const MapInfo& map, uint64_t i) {
   return b;
 }
 
-void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& boxes) {
+// `observed_x`: cells from there on are never observed, so that a box may hold bricks no shard has.
+void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& boxes,
+                              uint32_t observed_x = UINT32_MAX) {
   TempDir dir;
   auto store = OpenOrDie(map, dir.path());
-  for (uint64_t i = 0; i < 72; ++i) ASSERT_TRUE(store->Write(Scan(map, i)).ok());
+  for (uint64_t i = 0; i < 72; ++i) ASSERT_TRUE(store->Write(Scan(map, i, observed_x)).ok());
   ASSERT_TRUE(store->PublishModels().ok());
   // Then dynamic states without a published model: cells that change only after the publication.
   ObservationBatch late;
@@ -67,7 +70,7 @@ void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& bo
 
   const double t = 1.7e9 + 3600.0 * 90;
   for (const CellBox& box : boxes) {
-    std::vector<float> region;
+    std::vector<float> region(box.cell_count(), 7.0f);  // every cell must be written
     ASSERT_TRUE(store->PredictBox(box, t, {}, region).ok());
     ASSERT_EQ(region.size(), box.cell_count());
     // The same box as bytes (the UINT8 region), quantised by the shards as they write.
@@ -95,6 +98,13 @@ TEST(MapStoreRegionTest, FlatBoxesOfWholeAndPartBricksEqualPointPredictions) {
   // Bricks of 32×16: the first box holds whole bricks and parts, the second parts only along x.
   ExpectRegionsEqualPoints(GridMap("flat", 80, 40, 1, 2),
                            {CellBox{{0, 0, 0}, {80, 40, 1}}, CellBox{{1, 0, 0}, {64, 33, 1}}});
+}
+
+TEST(MapStoreRegionTest, CellsOfBricksNoShardHoldsAreUnobserved) {
+  // Cells from x = 40 on never observed: the bricks from x = 64 on exist in no shard, the one of
+  // x 32..63 is partly observed. Boxes over all of it, and from inside it.
+  ExpectRegionsEqualPoints(GridMap("partly", 130, 40, 1, 2),
+                           {CellBox{{0, 0, 0}, {130, 40, 1}}, CellBox{{35, 5, 0}, {129, 37, 1}}}, 40);
 }
 
 TEST(MapStoreRegionTest, CubicBoxesOfWholeAndPartBricksEqualPointPredictions) {

@@ -581,8 +581,8 @@ void Shard::PredictBoxConstant(const CellBox& box, const model::PhasorTable& tab
 // (ForEachBoxCell) made a 1M-cell UINT8 region's median 1.4-1.7x slower (fremen_query_load, two
 // pairs interleaved with main's fremend).
 template <typename T>
-void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                       T* out) const {
+void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options, T* out,
+                       uint8_t* held) const {
   if (box.cell_count() == 0) return;
   base::ReaderMutexLock lock(&mutex_);
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
@@ -603,9 +603,11 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   static_assert(BrickRegion::kNoHandle == kNone && BrickRegion::kNeverChanged == kStaticHandle,
                 "BrickRegion reads the shard's handles");
   std::optional<BrickRegion> whole_bricks;  // made at the first whole brick
+  const BoxBricks box_bricks(box, bs);
   for (size_t b = 0; b < walk.bricks.size(); ++b) {
     walk.PrefetchHandles(b + 1);
     const Brick* brick = walk.bricks[b].brick;
+    if (held != nullptr) held[box_bricks.Index(walk.bricks[b].bx, walk.bricks[b].by, walk.bricks[b].bz)] = 1;
     const BoxWalk::Cells c = walk.CellsIn(box, b);
     size_t m = 0;
     if (c.hi[0] - c.lo[0] == bs[0] && c.hi[1] - c.lo[1] == bs[1] && c.hi[2] - c.lo[2] == bs[2]) {
@@ -624,8 +626,7 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
           const uint32_t yz = walk.spread_y[y & (bs[1] - 1)] | walk.spread_z[z & (bs[2] - 1)];
           for (uint32_t x = c.lo[0]; x < c.hi[0]; ++x) {
             const uint32_t handle = brick->handles[yz | walk.spread_x[x & mask_x]];
-            if (handle == kNone) continue;
-            if (handle & kStaticHandle) {
+            if (handle & kStaticHandle) {  // kNone among them: 0.5
               row[x] = CellValue<T>(PredictHandle(handle, table, options));
             } else {
               __builtin_prefetch(models_.record(handle));
@@ -649,8 +650,10 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
     for (size_t i = 0; i < n; ++i) *published_cells[i] = CellValue<T>(predicted[i]);
   }
 }
-template void Shard::PredictBox(const CellBox&, const model::PhasorTable&, const PredictOptions&, float*) const;
-template void Shard::PredictBox(const CellBox&, const model::PhasorTable&, const PredictOptions&, uint8_t*) const;
+template void Shard::PredictBox(const CellBox&, const model::PhasorTable&, const PredictOptions&, float*,
+                                uint8_t*) const;
+template void Shard::PredictBox(const CellBox&, const model::PhasorTable&, const PredictOptions&, uint8_t*,
+                                uint8_t*) const;
 
 bool Shard::Observed(uint64_t key) const {
   base::ReaderMutexLock lock(&mutex_);

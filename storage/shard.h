@@ -136,12 +136,14 @@ class Shard {
   // --- readers ---
   // p(t) of one state (kUnobservedProbability when never observed).
   float Predict(uint64_t key, const model::PhasorTable& table, const PredictOptions& options) const;
-  // Writes p(t) of every cell of `box` held by this shard into out[index of the cell in the box]
-  // (x fastest, then y, then z); cells it does not hold are left as they are. T: float, or uint8_t
-  // for p quantised (CellValue, storage/brick_region.h).
+  // Writes p(t) of every cell of `box` in a brick this shard holds into out[index of the cell in
+  // the box] (x fastest, then y, then z), unobserved cells of those bricks included; other cells
+  // are left as they are. T: float, or uint8_t for p quantised (CellValue,
+  // storage/brick_region.h). `held` (when not null): held[bricks.Index(brick)] = 1 for each of
+  // those bricks, so that the caller fills only the others.
   template <typename T>
-  void PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options,
-                  T* out) const;
+  void PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options, T* out,
+                  uint8_t* held = nullptr) const;
   // PredictBox's first half for a box at many times: of the cells of `box` held by this shard,
   // those whose p(t) cannot change with t under `options` (VariesWithTime) get p(t) written into
   // out[index in the box], exactly as PredictBox writes it; the others get dynamic[index] = their
