@@ -82,22 +82,32 @@ void SumBlock(const RecordLayout& layout, Records records, size_t start, size_t 
   }
 }
 
-// SumBlock<used, true> for a block whose highest own order is `used` (<= kMax <= kUnrolledOrders).
+// SumBlock<used, masked> for a block whose highest own order is `used` (<= kMax <= kUnrolledOrders);
+// unmasked when every record's order is `used` (a multiplication by 1 changes nothing).
 template <int kMax, int kUsed = 0, typename Records>
-void SumBlockUpTo(int used, const RecordLayout& layout, Records records, size_t start, size_t n,
+void SumBlockUpTo(int used, bool masked, const RecordLayout& layout, Records records, size_t start, size_t n,
                   const float* cos_t, const float* sin_t, float* raw) {
   if constexpr (kUsed >= kMax) {
-    SumBlock<kMax, true>(layout, records, start, n, cos_t, sin_t, raw);
+    if (masked) {
+      SumBlock<kMax, true>(layout, records, start, n, cos_t, sin_t, raw);
+    } else {
+      SumBlock<kMax, false>(layout, records, start, n, cos_t, sin_t, raw);
+    }
   } else if (used == kUsed) {
-    SumBlock<kUsed, true>(layout, records, start, n, cos_t, sin_t, raw);
+    if (masked) {
+      SumBlock<kUsed, true>(layout, records, start, n, cos_t, sin_t, raw);
+    } else {
+      SumBlock<kUsed, false>(layout, records, start, n, cos_t, sin_t, raw);
+    }
   } else {
-    SumBlockUpTo<kMax, kUsed + 1>(used, layout, records, start, n, cos_t, sin_t, raw);
+    SumBlockUpTo<kMax, kUsed + 1>(used, masked, layout, records, start, n, cos_t, sin_t, raw);
   }
 }
 
 // kTerms components per record (kRuntime: `terms`). With kOwnOrder, kTerms is L and each record keeps
 // only its first `order` terms; a block of records goes through the loop of its highest order, not
-// L's: a map whose states all chose order 3 of L = 5 computes 3 terms a cell, not 5 with two masked.
+// L's: a map whose states all chose order 3 of L = 5 computes 3 terms a cell, not 5 with two masked
+// (and without the mask when all the block's orders are the same).
 // Finding that order reads each record's header first, which also starts every record's miss at
 // once rather than one after another.
 template <int kTerms, bool kOwnOrder, typename Records, typename Out>
@@ -109,11 +119,14 @@ void PredictRange(const CompactModels& models, Records records, size_t count, co
   for (size_t start = 0; start < count; start += kBlock) {
     const size_t n = std::min(kBlock, count - start);
     if constexpr (kOwnOrder && kTerms != kRuntime) {
-      int used = 0;
+      int used = 0, lowest = kTerms;
       for (size_t i = 0; i < n; ++i) {
-        used = std::max<int>(used, reinterpret_cast<const CompactModelHeader*>(layout(records[start + i]))->order);
+        const int order = reinterpret_cast<const CompactModelHeader*>(layout(records[start + i]))->order;
+        used = std::max(used, order);
+        lowest = std::min(lowest, order);
       }
-      SumBlockUpTo<kTerms>(std::min(used, kTerms), layout, records, start, n, cos_t, sin_t, raw);
+      used = std::min(used, kTerms);
+      SumBlockUpTo<kTerms>(used, /*masked=*/lowest < used, layout, records, start, n, cos_t, sin_t, raw);
     } else if constexpr (kTerms != kRuntime) {
       SumBlock<kTerms, false>(layout, records, start, n, cos_t, sin_t, raw);
     } else {
