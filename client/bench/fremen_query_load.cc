@@ -70,6 +70,7 @@ struct Options {
   int windows = 5;           // windows per batched figure (their median is printed)
   double window_predictions = 2e6;  // predictions per window of the batched Predict
   bool batched_only = false;  // only the batched Predict and its ceilings (for profiling the daemon)
+  std::string region_outputs = "both";  // float, uint8 or both (one alone: for profiling the daemon)
 };
 
 const char kUsage[] =
@@ -77,7 +78,8 @@ const char kUsage[] =
     "                         [--size=CELLS] [--scans=N] [--scan-interval=S] [--region-reps=N]\n"
     "                         [--series-times=N] [--series-reps=N] [--predict-calls=N]\n"
     "                         [--concurrency=N] [--batch=STATES] [--large-batch=STATES]\n"
-    "                         [--windows=N] [--window-predictions=N] [--batched-only]\n";
+    "                         [--windows=N] [--window-predictions=N] [--batched-only]\n"
+    "                         [--region-outputs=float|uint8|both]\n";
 
 Options Parse(int argc, char** argv) {
   Options o;
@@ -108,6 +110,13 @@ Options Parse(int argc, char** argv) {
     else if (key == "batch") o.batch = std::stoi(value);
     else if (key == "large-batch") o.large_batch = std::stoi(value);
     else if (key == "batched-only") o.batched_only = true;
+    else if (key == "region-outputs") {
+      if (value != "float" && value != "uint8" && value != "both") {
+        std::fprintf(stderr, "--region-outputs must be float, uint8 or both, got \"%s\"\n", value.c_str());
+        std::exit(2);
+      }
+      o.region_outputs = value;
+    }
     else if (key == "windows") o.windows = std::max(1, std::stoi(value));
     else if (key == "window-predictions") o.window_predictions = std::stod(value);
     else {
@@ -592,13 +601,19 @@ int main(int argc, char** argv) {
   // A count of 0 leaves its part out (e.g. --series-reps=0 --predict-calls=0: regions only, for
   // profiling the daemon); the series' ceilings need the regions.
   if (!options.batched_only && options.region_reps > 0) {
-    const auto floats = bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT", options.map);
-    bench.RegionCeiling(v1::REGION_OUTPUT_FLOAT, "FLOAT", floats);
-    const auto bytes = bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8", options.map);
-    bench.RegionCeiling(v1::REGION_OUTPUT_UINT8, "UINT8", bytes);
+    const bool floats_too = options.region_outputs != "uint8", bytes_too = options.region_outputs != "float";
+    Bench::RegionRun floats, bytes;
+    if (floats_too) {
+      floats = bench.Region(v1::REGION_OUTPUT_FLOAT, "FLOAT", options.map);
+      bench.RegionCeiling(v1::REGION_OUTPUT_FLOAT, "FLOAT", floats);
+    }
+    if (bytes_too) {
+      bytes = bench.Region(v1::REGION_OUTPUT_UINT8, "UINT8", options.map);
+      bench.RegionCeiling(v1::REGION_OUTPUT_UINT8, "UINT8", bytes);
+    }
     if (options.series_reps > 0) {
-      bench.RegionSeries(v1::REGION_OUTPUT_FLOAT, "FLOAT", floats);
-      bench.RegionSeries(v1::REGION_OUTPUT_UINT8, "UINT8", bytes);
+      if (floats_too) bench.RegionSeries(v1::REGION_OUTPUT_FLOAT, "FLOAT", floats);
+      if (bytes_too) bench.RegionSeries(v1::REGION_OUTPUT_UINT8, "UINT8", bytes);
     }
   }
   // The batched figures' ceilings are made of single-state calls.
