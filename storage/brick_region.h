@@ -15,6 +15,8 @@
 //
 // The box's array holds p as float, or quantised as bytes (CellValue<uint8_t>, the UINT8 region
 // output), so that a UINT8 region is written once, in its wire form, rather than as floats first.
+// BoxBricks, beside it, numbers the bricks a box overlaps, so that the cells of bricks no shard
+// holds are filled after the shards have written theirs.
 #pragma once
 
 #include <algorithm>

@@ -591,10 +591,10 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   const uint32_t mask_x = bs[0] - 1;  // brick sides are powers of two
   // The cells whose state has a published model — nearly all dynamic ones, on a map in use — go
   // through the region kernel together, a brick at a time; the others are answered one by one.
-  // Whether a state is published is in its model record, which is cold: the brick's dynamic
-  // states are gathered first with their records prefetched, and told apart once those are on
-  // their way (a miss per dynamic cell, one after another, and one per line of a brick's handles
-  // were most of a 1M-cell region's samples).
+  // The brick's dynamic states are gathered first, their records prefetched for the kernel, then
+  // told apart by the published bits kept beside the records (CompactModels::published), which
+  // read no record (a miss per dynamic cell, one after another, was most of a 1M-cell region's
+  // samples when the check read the record's header).
   std::array<uint32_t, 512> dynamic, published;
   std::array<T*, 512> dynamic_cells, published_cells;
   std::array<float, 512> predicted;

@@ -15,9 +15,9 @@
 //     ~80k predictions/s).
 // Against a running fremend. With --create it first creates a grid map (and the ceiling's empty
 // one, "<map>-unobserved") and fills it through the IngestService (a dense patch per scan: walls,
-// free space and 1/8 of the cells on a daily rhythm),
-// running the update job through the AdminService after each simulated day, as the nightly job
-// would, so that dynamic cells hold published models whose orders were chosen on evidence.
+// free space and 1/8 of the cells on a daily rhythm), running the update job through the
+// AdminService after each simulated day, as the nightly job would, so that dynamic cells hold
+// published models whose orders were chosen on evidence.
 // Without those services, prepare a map another way (see client/bench/README.md).
 //
 // Uses only the API (fremen_proto + gRPC), as any client does. Single-threaded except for the

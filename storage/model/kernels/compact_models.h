@@ -67,8 +67,7 @@ class CompactModels {
   // dynamic cell was 15% of a region's samples in Shard::PredictBox).
   bool published(size_t i) const { return (published_bits_[i / 64] >> (i % 64)) & 1u; }
   // Flags record i published (its header and bit), for a writer that fills its components itself
-  // (Publisher).
-  // Atomic on the bit's word, so that writers of disjoint records may still run at once (Publisher).
+  // (Publisher). Atomic on the bit's word, so that writers of disjoint records may still run at once.
   void MarkPublished(size_t i) {
     header(i).published = 1;
     std::atomic_ref(published_bits_[i / 64]).fetch_or(uint64_t{1} << (i % 64), std::memory_order_relaxed);

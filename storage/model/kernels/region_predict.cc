@@ -83,24 +83,19 @@ void SumBlock(const RecordLayout& layout, Records records, size_t start, size_t 
 }
 
 // SumBlock<used, masked> for a block whose highest own order is `used` (<= kMax <= kUnrolledOrders);
-// unmasked when every record's order is `used` (a multiplication by 1 changes nothing).
+// `masked` false when every record's order is `used` (a multiplication by 1 changes nothing).
 template <int kMax, int kUsed = 0, typename Records>
 void SumBlockUpTo(int used, bool masked, const RecordLayout& layout, Records records, size_t start, size_t n,
                   const float* cos_t, const float* sin_t, float* raw) {
-  if constexpr (kUsed >= kMax) {
-    if (masked) {
-      SumBlock<kMax, true>(layout, records, start, n, cos_t, sin_t, raw);
-    } else {
-      SumBlock<kMax, false>(layout, records, start, n, cos_t, sin_t, raw);
+  if constexpr (kUsed < kMax) {
+    if (used != kUsed) {
+      return SumBlockUpTo<kMax, kUsed + 1>(used, masked, layout, records, start, n, cos_t, sin_t, raw);
     }
-  } else if (used == kUsed) {
-    if (masked) {
-      SumBlock<kUsed, true>(layout, records, start, n, cos_t, sin_t, raw);
-    } else {
-      SumBlock<kUsed, false>(layout, records, start, n, cos_t, sin_t, raw);
-    }
+  }
+  if (masked) {
+    SumBlock<kUsed, true>(layout, records, start, n, cos_t, sin_t, raw);
   } else {
-    SumBlockUpTo<kMax, kUsed + 1>(used, masked, layout, records, start, n, cos_t, sin_t, raw);
+    SumBlock<kUsed, false>(layout, records, start, n, cos_t, sin_t, raw);
   }
 }
 
