@@ -628,10 +628,16 @@ TEST_F(IngestServiceTest, SigtermDuringIngestLosesNoAcknowledgedBatch) {
   Stream resend(*ingest_);
   for (uint64_t i = 0; i < sent; ++i) {
     const v1::IngestResponse response = resend.Call(RowBatch("lab", 1, i));
+    if (response.has_error()) {
+      // Only a batch older than the sequences the map remembers of this writer may be refused:
+      // the map then holds newer batches of the writer, which a stream applies in order after this
+      // one, so it was not lost. (The writer may have sent more than that window before the stop.)
+      EXPECT_THAT(response.error().message(), HasSubstr("older than the last")) << i;
+      continue;
+    }
     if (acked.count(i)) {
       EXPECT_TRUE(response.duplicate()) << i;
     }
-    EXPECT_FALSE(response.has_error());
   }
   EXPECT_TRUE(resend.Close().ok());
 }
