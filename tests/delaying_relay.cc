@@ -31,14 +31,16 @@ absl::StatusOr<sockaddr_in> LoopbackAddressOf(const std::string& address) {
   return in;
 }
 
-// Copies `from` to `to` until `from` ends, then ends `to`'s sending side.
+// Copies `from` to `to` until `from` ends, then ends `to`'s sending side. MSG_NOSIGNAL: a peer
+// that has closed its end (the client at the end of a test) is a failed send, not a SIGPIPE that
+// kills the test's process.
 void Copy(int from, int to) {
   char buffer[16384];
   for (;;) {
     const ssize_t got = read(from, buffer, sizeof buffer);
     if (got <= 0) break;
     for (ssize_t sent = 0; sent < got;) {
-      const ssize_t wrote = write(to, buffer + sent, static_cast<size_t>(got - sent));
+      const ssize_t wrote = send(to, buffer + sent, static_cast<size_t>(got - sent), MSG_NOSIGNAL);
       if (wrote <= 0) {
         shutdown(to, SHUT_WR);
         return;
