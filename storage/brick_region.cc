@@ -9,18 +9,16 @@ BoxBricks::BoxBricks(const CellBox& box, const std::array<uint32_t, 3>& brick_si
   }
 }
 
-BrickRegion::BrickRegion(const GridKeys& keys, uint64_t nx, uint64_t ny) : flat_(keys.flat()) {
-  const std::array<uint32_t, 3> bs = keys.brick_size();
-  for (uint32_t z = 0; z < bs[2]; ++z) {
-    for (uint32_t y = 0; y < bs[1]; ++y) {
-      for (uint32_t x = 0; x < bs[0]; ++x) {
-        offset_[keys.LocalIndex(x, y, z)] = static_cast<int64_t>((uint64_t{z} * ny + y) * nx + x);
+BrickLayout::BrickLayout(const GridKeys& keys) : size_(keys.brick_size()) {
+  shift_y_ = static_cast<uint32_t>(std::countr_zero(size_[0]));
+  shift_z_ = shift_y_ + static_cast<uint32_t>(std::countr_zero(size_[1]));
+  for (uint32_t z = 0; z < size_[2]; ++z) {
+    for (uint32_t y = 0; y < size_[1]; ++y) {
+      for (uint32_t x = 0; x < size_[0]; ++x) {
+        row_major_[keys.LocalIndex(x, y, z)] = static_cast<uint16_t>((z * size_[1] + y) * size_[0] + x);
       }
     }
   }
-  // See WriteSixteenAtATime: lanes 0 and 2 of v[0] and of the vector holding the block's other half.
-  const uint32_t other_half = flat_ ? 8 : 4;
-  row_start_ = {0, 2, other_half, other_half + 2};
 }
 
 }  // namespace fremen::storage

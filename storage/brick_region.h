@@ -1,17 +1,14 @@
-// BrickRegion: the cells of one whole brick written into a box's row-major array of p, sixteen at a
-// time, for region queries (Shard::PredictBox).
+// How a brick's cells get into a region: a box's row-major array of p, written by the shards
+// (Shard::PredictBox).
 //
-// A brick's 512 handles are in Morton order; a box is row-major. Walking the box and looking up each
-// cell's handle costs a dozen instructions a cell, most of a region's time on a map of mostly
-// never-changed cells. But sixteen consecutive handles of a brick are a 4×4 block of a flat brick
-// (key bits x0 y0 x1 y1) or a 4×2×2 block of a cubic one (x0 y0 z0 x1): four rows of four cells.
-// So a whole brick goes sixteen handles at a time: four loads, their values (a never-changed
-// cell's bit as 0 or 1, an unobserved cell's 0.5) converted together, two shuffles into four rows,
-// four stores; the dynamic handles among the sixteen (a mask of their sign bits) go to the caller,
-// which predicts them and overwrites their cells. A brick only partly in the box is the caller's.
-//
-// Handles as the shard keeps them: kNoHandle (unobserved), kNeverChanged | value, or a dynamic
-// state's index (top bit clear).
+// A brick's 512 handles are in Morton order; a box is row-major. Reading each cell's 4-byte handle
+// and turning it into p was most of a 1M-cell region's time on a map of mostly never-changed cells
+// (docs/performance.md). So each brick of a grid also keeps a BrickImage: its never-changed and
+// unobserved cells as the bytes of the UINT8 output, row-major (x fastest), and a list of its
+// dynamic cells. A region copies a brick's rows (32 bytes of a flat brick, 8 of a cubic one) and
+// predicts the listed cells; it reads no handle. The image is kept by the shard as it sets each
+// handle (Shard::SetHandle), so it is never stale: a cell only ever goes from unobserved to never
+// changed to dynamic, and a dynamic index is its state's for the shard's life.
 //
 // The box's array holds p as float, or quantised as bytes (CellValue<uint8_t>, the UINT8 region
 // output), so that a UINT8 region is written once, in its wire form, rather than as floats first.
@@ -25,6 +22,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -97,99 +95,99 @@ void BoxBricks::FillUnheld(const uint8_t* held, T value, T* out) const {
   }
 }
 
-class BrickRegion {
+// Where a brick's cells sit in its image: the row-major index (x fastest, then y, then z) of each
+// Morton index, for the brick shape of one grid (32×16×1 or 8×8×8, sides powers of two).
+class BrickLayout {
  public:
-  static constexpr uint32_t kNoHandle = UINT32_MAX;
-  static constexpr uint32_t kNeverChanged = 0x80000000u;
+  explicit BrickLayout(const GridKeys& keys);
 
-  // For a box nx cells along x and ny along y, of a grid keyed by `keys`.
-  BrickRegion(const GridKeys& keys, uint64_t nx, uint64_t ny);
-
-  // Position of the brick's cell with handle index i relative to the brick's first cell (its lowest
-  // x, y, z), in the box's row-major order.
-  int64_t offset(uint32_t i) const { return offset_[i]; }
-
-  // Writes p of each never-changed and each unobserved cell of a whole brick, whose first cell is
-  // at `origin` in the box, and calls on_dynamic(handle, T* cell) for each other cell, in handle
-  // order. The dynamic cells' values are left for the caller to write. T: float or uint8_t.
-  // REQUIRES: the whole brick is inside the box.
-  template <typename T, typename OnDynamic>
-  void Write(const uint32_t* handles, T* origin, OnDynamic on_dynamic) const {
-#if defined(__SSE2__)  // every x86-64
-    WriteSixteenAtATime(handles, origin, on_dynamic);
-#else
-    WriteEachCell(handles, origin, on_dynamic);
-#endif
-  }
-
-  // Write's two ways, the same result: public so that the tests compare both with the cell by cell
-  // walk on any machine that has SSE2.
-  template <typename T, typename OnDynamic>
-  void WriteEachCell(const uint32_t* handles, T* origin, OnDynamic on_dynamic) const {
-    for (uint32_t i = 0; i < 512; ++i) {
-      const uint32_t h = handles[i];
-      if (h & kNeverChanged) {
-        origin[offset_[i]] = CellValue<T>(h == kNoHandle ? kUnobservedProbability : static_cast<float>(h & 1u));
-      } else {
-        on_dynamic(h, origin + offset_[i]);
-      }
-    }
-  }
-#if defined(__SSE2__)
-  template <typename T, typename OnDynamic>
-  void WriteSixteenAtATime(const uint32_t* handles, T* origin, OnDynamic on_dynamic) const;
-#endif
+  const std::array<uint32_t, 3>& size() const { return size_; }
+  uint32_t RowMajor(uint32_t local) const { return row_major_[local]; }
+  // The axes of row-major index i.
+  uint32_t X(uint32_t i) const { return i & (size_[0] - 1); }
+  uint32_t Y(uint32_t i) const { return (i >> shift_y_) & (size_[1] - 1); }
+  uint32_t Z(uint32_t i) const { return i >> shift_z_; }
 
  private:
-#if defined(__SSE2__)
-  // Four cells of a row, p in each lane.
-  static void StoreRow(float* cells, __m128 p) { _mm_storeu_ps(cells, p); }
-  // As four bytes: round(255·p) as QuantizeProbability makes it (p·255 + 0.5 truncated).
-  static void StoreRow(uint8_t* cells, __m128 p) {
-    const __m128i q = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(p, _mm_set1_ps(255.0f)), _mm_set1_ps(0.5f)));
-    const __m128i halves = _mm_packs_epi32(q, q);
-    const int32_t four = _mm_cvtsi128_si32(_mm_packus_epi16(halves, halves));
-    std::memcpy(cells, &four, sizeof(four));
-  }
-#endif
-
-  // Handle index of the first cell of row r (0..3) of a group of sixteen, relative to the group's
-  // first: rows 0, 1 are lanes 0 and 2 of the first four handles; rows 2, 3 the same lanes of the
-  // four handles that hold the other half of the block (the next y pair of a flat brick, z + 1 of
-  // a cubic one).
-  std::array<uint32_t, 4> row_start_;
-  bool flat_;
-  std::array<int64_t, 512> offset_;
+  std::array<uint32_t, 3> size_;
+  uint32_t shift_y_, shift_z_;
+  std::array<uint16_t, 512> row_major_;
 };
 
-#if defined(__SSE2__)
-template <typename T, typename OnDynamic>
-void BrickRegion::WriteSixteenAtATime(const uint32_t* handles, T* origin, OnDynamic on_dynamic) const {
-  const __m128i none = _mm_set1_epi32(-1), bit = _mm_set1_epi32(1);
-  const __m128 unobserved = _mm_set1_ps(kUnobservedProbability);
-  for (uint32_t g = 0; g < 512; g += 16) {
-    __m128 v[4];
-    uint32_t never_changed_or_none = 0;  // sign bits of the sixteen handles
-    for (int q = 0; q < 4; ++q) {
-      const __m128i h = _mm_loadu_si128(reinterpret_cast<const __m128i*>(handles + g + 4 * q));
-      const __m128 is_none = _mm_castsi128_ps(_mm_cmpeq_epi32(h, none));
-      const __m128 value = _mm_cvtepi32_ps(_mm_and_si128(h, bit));
-      v[q] = _mm_or_ps(_mm_andnot_ps(is_none, value), _mm_and_ps(is_none, unobserved));
-      never_changed_or_none |= static_cast<uint32_t>(_mm_movemask_ps(_mm_castsi128_ps(h))) << (4 * q);
-    }
-    // Flat (x0 y0 x1 y1): v[1] is v[0] at x + 2, v[3] is v[2] at x + 2. Cubic (x0 y0 z0 x1): v[2]
-    // is v[0] at x + 2, v[3] is v[1] at x + 2.
-    const __m128 a = v[0], b = flat_ ? v[1] : v[2], c = flat_ ? v[2] : v[1], d = v[3];
-    StoreRow(origin + offset_[g + row_start_[0]], _mm_movelh_ps(a, b));
-    StoreRow(origin + offset_[g + row_start_[1]], _mm_movehl_ps(b, a));
-    StoreRow(origin + offset_[g + row_start_[2]], _mm_movelh_ps(c, d));
-    StoreRow(origin + offset_[g + row_start_[3]], _mm_movehl_ps(d, c));
-    for (uint32_t dynamic = ~never_changed_or_none & 0xffffu; dynamic != 0; dynamic &= dynamic - 1) {
-      const uint32_t i = g + static_cast<uint32_t>(std::countr_zero(dynamic));
-      on_dynamic(handles[i], origin + offset_[i]);
+// One brick as a region query reads it. Value type.
+class BrickImage {
+ public:
+  // Handles as the shard keeps them: kNoHandle (unobserved), kNeverChanged | value, or a dynamic
+  // state's index (top bit clear).
+  static constexpr uint32_t kNoHandle = UINT32_MAX;
+  static constexpr uint32_t kNeverChanged = 0x80000000u;
+  // A dynamic cell: its state's index and its row-major index in the brick.
+  struct DynamicCell {
+    uint32_t handle;
+    uint32_t cell;
+  };
+
+  BrickImage() { bytes_.fill(kUnobservedByte); }
+
+  // Cell i (row-major) now has `handle`. REQUIRES: a cell's handle goes only from kNoHandle to
+  // never changed to dynamic (or straight to dynamic), and is set dynamic once.
+  void Set(uint32_t i, uint32_t handle) {
+    if (handle & kNeverChanged) {
+      bytes_[i] = handle == kNoHandle ? kUnobservedByte : (handle & 1u) ? 255 : 0;
+    } else {
+      dynamic_.push_back({handle, i});
     }
   }
+
+  // p of the cells [i, i + n) of one row, never-changed and unobserved ones exact (dynamic ones
+  // are the caller's to overwrite), as T.
+  template <typename T>
+  void CopyRow(uint32_t i, uint32_t n, T* out) const;
+
+  const std::vector<DynamicCell>& dynamic() const { return dynamic_; }
+  const uint8_t* bytes() const { return bytes_.data(); }
+  size_t memory_bytes() const { return sizeof(*this) + dynamic_.capacity() * sizeof(DynamicCell); }
+
+ private:
+  static constexpr uint8_t kUnobservedByte = 128;  // CellValue<uint8_t>(kUnobservedProbability)
+
+  // A byte back to p: 0 → 0, 128 → 0.5, 255 → 1, exactly ((b + 1) >> 7 is 0, 1 or 2 halves).
+  static float FloatOf(uint8_t b) { return static_cast<float>((b + 1) >> 7) * 0.5f; }
+
+  std::array<uint8_t, 512> bytes_;
+  std::vector<DynamicCell> dynamic_;  // in the order their states became dynamic
+};
+
+template <>
+inline void BrickImage::CopyRow<uint8_t>(uint32_t i, uint32_t n, uint8_t* out) const {
+  // A whole row of a flat or a cubic brick in a few moves, not a call.
+  if (n == 32) {
+    std::memcpy(out, bytes_.data() + i, 32);
+  } else if (n == 8) {
+    std::memcpy(out, bytes_.data() + i, 8);
+  } else {
+    std::memcpy(out, bytes_.data() + i, n);
+  }
 }
+
+template <>
+inline void BrickImage::CopyRow<float>(uint32_t i, uint32_t n, float* out) const {
+  const uint8_t* in = bytes_.data() + i;
+  uint32_t k = 0;
+#if defined(__SSE2__)  // every x86-64: sixteen cells at a time
+  const __m128i zero = _mm_setzero_si128(), one = _mm_set1_epi16(1);
+  const __m128 half = _mm_set1_ps(0.5f);
+  for (; k + 16 <= n; k += 16) {
+    const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + k));
+    const __m128i halves[2] = {_mm_srli_epi16(_mm_add_epi16(_mm_unpacklo_epi8(b, zero), one), 7),
+                               _mm_srli_epi16(_mm_add_epi16(_mm_unpackhi_epi8(b, zero), one), 7)};
+    for (int h = 0; h < 2; ++h) {
+      _mm_storeu_ps(out + k + 8 * h, _mm_mul_ps(_mm_cvtepi32_ps(_mm_unpacklo_epi16(halves[h], zero)), half));
+      _mm_storeu_ps(out + k + 8 * h + 4, _mm_mul_ps(_mm_cvtepi32_ps(_mm_unpackhi_epi16(halves[h], zero)), half));
+    }
+  }
 #endif
+  for (; k < n; ++k) out[k] = FloatOf(in[k]);
+}
 
 }  // namespace fremen::storage

@@ -2,104 +2,110 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <map>
 #include <random>
+#include <set>
 #include <vector>
 
 namespace fremen::storage {
 namespace {
 
-// A brick of random handles (unobserved, never changed at 0 or 1, dynamic) written into a box
-// larger than the brick, at an offset inside it, as floats or as bytes: every cell of the brick
-// must hold what the cell by cell walk gives (as a byte, its QuantizeProbability), every dynamic
-// cell must be reported once with its handle and its place, and no cell outside the brick may be
-// touched.
-enum class Way { kEachCell, kSixteenAtATime };
-
-template <typename T>
-void CheckAgainstCellByCell(const GridKeys& keys, Way way, uint64_t seed) {
+// Every cell of a brick has one row-major place, and X, Y, Z give back its axes.
+void CheckLayout(const GridKeys& keys) {
+  const BrickLayout layout(keys);
   const std::array<uint32_t, 3> bs = keys.brick_size();
-  const uint64_t nx = bs[0] + 5, ny = bs[1] + 3, nz = bs[2] + 2;
-  const std::array<uint64_t, 3> at = {3, 1, bs[2] > 1 ? 1u : 0u};  // the brick's first cell in the box
-  std::mt19937_64 rng(seed);
-  std::array<uint32_t, 512> handles;
-  for (uint32_t& h : handles) {
-    switch (rng() % 4) {
-      case 0: h = BrickRegion::kNoHandle; break;
-      case 1: h = BrickRegion::kNeverChanged | static_cast<uint32_t>(rng() % 2); break;
-      case 2: h = BrickRegion::kNeverChanged; break;
-      default: h = static_cast<uint32_t>(rng() % 1000000); break;  // a dynamic index
-    }
-  }
-  const T kUntouched = static_cast<T>(77);  // neither 0, 0.5, 1 nor their bytes 0, 128, 255
-  std::vector<T> box(nx * ny * nz, kUntouched);
-  const BrickRegion region(keys, nx, ny);
-  T* origin = box.data() + (at[2] * ny + at[1]) * nx + at[0];
-  std::map<const T*, uint32_t> reported;
-  const auto report = [&](uint32_t handle, T* cell) {
-    EXPECT_TRUE(reported.emplace(cell, handle).second) << "a dynamic cell reported twice";
-  };
-  if (way == Way::kEachCell) {
-    region.WriteEachCell(handles.data(), origin, report);
-  } else {
-#if defined(__SSE2__)
-    region.WriteSixteenAtATime(handles.data(), origin, report);
-#endif
-  }
-  size_t dynamic = 0;
-  for (uint64_t z = 0; z < nz; ++z) {
-    for (uint64_t y = 0; y < ny; ++y) {
-      for (uint64_t x = 0; x < nx; ++x) {
-        const T* cell = &box[(z * ny + y) * nx + x];
-        const bool inside = x >= at[0] && x < at[0] + bs[0] && y >= at[1] && y < at[1] + bs[1] &&
-                            z >= at[2] && z < at[2] + bs[2];
-        if (!inside) {
-          ASSERT_EQ(*cell, kUntouched) << "outside the brick: " << x << "," << y << "," << z;
-          continue;
-        }
-        const uint32_t i = keys.LocalIndex(static_cast<uint32_t>(x - at[0]), static_cast<uint32_t>(y - at[1]),
-                                           static_cast<uint32_t>(z - at[2]));
-        ASSERT_EQ(cell, origin + region.offset(i));
-        const uint32_t h = handles[i];
-        if (h == BrickRegion::kNoHandle) {
-          ASSERT_EQ(*cell, CellValue<T>(kUnobservedProbability)) << x << "," << y << "," << z;
-        } else if (h & BrickRegion::kNeverChanged) {
-          ASSERT_EQ(*cell, CellValue<T>(static_cast<float>(h & 1u))) << x << "," << y << "," << z;
-        } else {
-          ++dynamic;
-          const auto it = reported.find(cell);
-          ASSERT_NE(it, reported.end()) << "dynamic cell not reported: " << x << "," << y << "," << z;
-          EXPECT_EQ(it->second, h);
-        }
+  ASSERT_EQ(layout.size(), bs);
+  std::set<uint32_t> seen;
+  for (uint32_t z = 0; z < bs[2]; ++z) {
+    for (uint32_t y = 0; y < bs[1]; ++y) {
+      for (uint32_t x = 0; x < bs[0]; ++x) {
+        const uint32_t i = layout.RowMajor(keys.LocalIndex(x, y, z));
+        EXPECT_EQ(i, (z * bs[1] + y) * bs[0] + x);
+        EXPECT_EQ(layout.X(i), x);
+        EXPECT_EQ(layout.Y(i), y);
+        EXPECT_EQ(layout.Z(i), z);
+        seen.insert(i);
       }
     }
   }
-  EXPECT_GT(dynamic, 0u);
-  EXPECT_EQ(reported.size(), dynamic);
+  EXPECT_EQ(seen.size(), 512u);
 }
 
-// Write takes the sixteen-at-a-time way on x86-64 (SSE2) and the cell-by-cell way elsewhere; both
-// are checked here wherever they compile.
+TEST(BrickLayoutTest, EachCellHasOneRowMajorPlace) {
+  CheckLayout(GridKeys::For(1));
+  CheckLayout(GridKeys::For(8));
+}
+
+// A brick whose cells go through the handles a shard gives them — unobserved, then never changed
+// at 0 or 1, then dynamic, each cell stopping at a random step — and rows of it copied whole and
+// in parts, as floats and as bytes: each never-changed or unobserved cell must be its p (as a
+// byte, its quantisation), no cell outside the copied part touched, and the dynamic cells listed
+// once each with their handle.
 template <typename T>
-void CheckBothWays(const GridKeys& keys) {
-  for (uint64_t seed = 1; seed <= 20; ++seed) CheckAgainstCellByCell<T>(keys, Way::kEachCell, seed);
-#if defined(__SSE2__)
-  for (uint64_t seed = 1; seed <= 20; ++seed) CheckAgainstCellByCell<T>(keys, Way::kSixteenAtATime, seed);
-#endif
+void CheckImage(uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  BrickImage image;
+  std::array<uint32_t, 512> handles;
+  handles.fill(BrickImage::kNoHandle);
+  uint32_t next_dynamic = 1000;
+  for (int step = 0; step < 3; ++step) {
+    for (uint32_t i = 0; i < 512; ++i) {
+      const uint32_t h = handles[i];
+      if (rng() % 3 == 0 || !(h & BrickImage::kNeverChanged)) continue;  // stays; dynamic stays for good
+      // Unobserved → never changed (or straight to dynamic); never changed → dynamic.
+      handles[i] = h == BrickImage::kNoHandle && rng() % 4 != 0
+                       ? BrickImage::kNeverChanged | static_cast<uint32_t>(rng() % 2)
+                       : next_dynamic++;
+      image.Set(i, handles[i]);
+    }
+  }
+  std::map<uint32_t, uint32_t> listed;  // cell → handle
+  for (const BrickImage::DynamicCell& cell : image.dynamic()) {
+    EXPECT_TRUE(listed.emplace(cell.cell, cell.handle).second) << "cell " << cell.cell << " listed twice";
+  }
+  size_t kinds[4] = {};  // unobserved, at 0, at 1, dynamic
+  for (uint32_t i = 0; i < 512; ++i) {
+    const uint32_t h = handles[i];
+    if (h & BrickImage::kNeverChanged) {
+      ++kinds[h == BrickImage::kNoHandle ? 0 : 1 + (h & 1u)];
+      EXPECT_EQ(listed.count(i), 0u) << i;
+    } else {
+      ++kinds[3];
+      ASSERT_EQ(listed.count(i), 1u) << "dynamic cell " << i << " not listed";
+      EXPECT_EQ(listed[i], h);
+    }
+  }
+  for (size_t kind = 0; kind < 4; ++kind) ASSERT_GT(kinds[kind], 0u) << "kind " << kind;
+
+  const T kUntouched = static_cast<T>(77);  // neither 0, 0.5, 1 nor their bytes 0, 128, 255
+  for (uint32_t first = 0; first < 512; first += 37) {
+    for (const uint32_t n : {1u, 7u, 16u, 21u, 32u}) {
+      if (first + n > 512) continue;
+      std::array<T, 34> out;  // a row of up to 32 cells between two that must stay untouched
+      out.fill(kUntouched);
+      image.CopyRow(first, n, out.data() + 1);
+      EXPECT_EQ(out[0], kUntouched);
+      EXPECT_EQ(out[n + 1], kUntouched);
+      for (uint32_t k = 0; k < n; ++k) {
+        const uint32_t h = handles[first + k];
+        if (!(h & BrickImage::kNeverChanged)) continue;  // the caller's to write
+        const float p = h == BrickImage::kNoHandle ? kUnobservedProbability : static_cast<float>(h & 1u);
+        ASSERT_EQ(out[1 + k], CellValue<T>(p)) << "cell " << first + k << " of a row of " << n;
+      }
+    }
+  }
 }
 
-TEST(BrickRegionTest, FlatBrickEqualsTheCellByCellWalk) {
-  CheckBothWays<float>(GridKeys::For(1));
-  CheckBothWays<uint8_t>(GridKeys::For(1));
-}
-
-TEST(BrickRegionTest, CubicBrickEqualsTheCellByCellWalk) {
-  CheckBothWays<float>(GridKeys::For(8));
-  CheckBothWays<uint8_t>(GridKeys::For(8));
+TEST(BrickImageTest, RowsHoldTheNeverChangedAndUnobservedCellsAndTheDynamicOnesAreListed) {
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    CheckImage<float>(seed);
+    CheckImage<uint8_t>(seed);
+  }
 }
 
 // A byte is round(255·p): 0, 128 (an unobserved cell's 0.5) and 255.
-TEST(BrickRegionTest, BytesAreTheQuantisedProbabilities) {
+TEST(BrickImageTest, BytesAreTheQuantisedProbabilities) {
   EXPECT_EQ(CellValue<uint8_t>(0.0f), 0);
   EXPECT_EQ(CellValue<uint8_t>(kUnobservedProbability), 128);
   EXPECT_EQ(CellValue<uint8_t>(1.0f), 255);

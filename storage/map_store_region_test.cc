@@ -1,8 +1,8 @@
-// MapStore::PredictBox over boxes that hold whole bricks (BrickRegion's sixteen-at-a-time path)
-// and parts of bricks (the cell-by-cell walk), as floats and as bytes: every cell must be what a
-// point prediction gives (a byte, its quantisation), for a flat and a cubic grid, with
-// never-changed cells at 0 and at 1, unobserved cells, and dynamic ones with and without a
-// published model.
+// MapStore::PredictBox over boxes that hold whole bricks and parts of bricks, as floats and as
+// bytes: every cell must be what a point prediction gives (a byte, its quantisation), for a flat
+// and a cubic grid, with never-changed cells at 0 and at 1, unobserved cells, and dynamic ones with
+// and without a published model — after the cells have changed kind between two regions, and
+// after a reopening (the bricks' images, storage/brick_region.h, follow every handle).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -46,13 +46,44 @@ ObservationBatch Scan(const MapInfo& map, uint64_t i, uint32_t observed_x) {
   return b;
 }
 
+// Each box at time t, as floats and as bytes, against the point predictions of its cells.
+void ExpectBoxesEqualPoints(const MapStore& store, const MapInfo& map, const std::vector<CellBox>& boxes, double t) {
+  for (const CellBox& box : boxes) {
+    std::vector<float> region(box.cell_count(), 7.0f);  // every cell must be written
+    ASSERT_TRUE(store.PredictBox(box, t, {}, region).ok());
+    ASSERT_EQ(region.size(), box.cell_count());
+    // The same box as bytes (the UINT8 region), quantised by the shards as they write.
+    std::vector<uint8_t> bytes(box.cell_count(), 77);
+    ASSERT_TRUE(store.PredictBox(box, t, {}, std::span<uint8_t>(bytes)).ok());
+    size_t i = 0;
+    size_t kinds[4] = {};  // unobserved, never changed at 0, at 1, dynamic
+    for (uint32_t z = box.lo[2]; z < box.hi[2]; ++z) {
+      for (uint32_t y = box.lo[1]; y < box.hi[1]; ++y) {
+        for (uint32_t x = box.lo[0]; x < box.hi[0]; ++x, ++i) {
+          const uint64_t key = map.grid.keys().Key(x, y, z);
+          const double times[] = {t};
+          ASSERT_EQ(region[i], store.Predict({&key, 1}, times, {})[0]) << x << "," << y << "," << z;
+          ASSERT_EQ(bytes[i], model::QuantizeProbability(region[i])) << x << "," << y << "," << z;
+          const auto snapshot = store.Snapshot(key);
+          ++kinds[!snapshot ? 0 : !snapshot->is_static ? 3 : snapshot->static_state.value() == 1.0f ? 2 : 1];
+        }
+      }
+    }
+    for (size_t kind = 0; kind < 4; ++kind) EXPECT_GT(kinds[kind], 0u) << "kind " << kind;
+  }
+}
+
 // `observed_x`: cells from there on are never observed, so that a box may hold bricks no shard has.
 void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& boxes,
                               uint32_t observed_x = UINT32_MAX) {
   TempDir dir;
   auto store = OpenOrDie(map, dir.path());
-  for (uint64_t i = 0; i < 72; ++i) ASSERT_TRUE(store->Write(Scan(map, i, observed_x)).ok());
+  // A first few scans, then the rest, which observe more cells and change more of them.
+  const double t = 1.7e9 + 3600.0 * 90;
+  for (uint64_t i = 0; i < 6; ++i) ASSERT_TRUE(store->Write(Scan(map, i, std::min(observed_x, map.grid.size[0]) / 2)).ok());
+  for (uint64_t i = 6; i < 72; ++i) ASSERT_TRUE(store->Write(Scan(map, i, observed_x)).ok());
   ASSERT_TRUE(store->PublishModels().ok());
+  ExpectBoxesEqualPoints(*store, map, boxes, t);
   // Then dynamic states without a published model: cells that change only after the publication.
   ObservationBatch late;
   late.writer_id = 2;
@@ -67,31 +98,12 @@ void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& bo
   }
   ASSERT_FALSE(late.keys.empty());
   ASSERT_TRUE(store->Write(std::move(late)).ok());
-
-  const double t = 1.7e9 + 3600.0 * 90;
-  for (const CellBox& box : boxes) {
-    std::vector<float> region(box.cell_count(), 7.0f);  // every cell must be written
-    ASSERT_TRUE(store->PredictBox(box, t, {}, region).ok());
-    ASSERT_EQ(region.size(), box.cell_count());
-    // The same box as bytes (the UINT8 region), quantised by the shards as they write.
-    std::vector<uint8_t> bytes(box.cell_count(), 77);
-    ASSERT_TRUE(store->PredictBox(box, t, {}, std::span<uint8_t>(bytes)).ok());
-    size_t i = 0;
-    size_t kinds[4] = {};  // unobserved, never changed at 0, at 1, dynamic
-    for (uint32_t z = box.lo[2]; z < box.hi[2]; ++z) {
-      for (uint32_t y = box.lo[1]; y < box.hi[1]; ++y) {
-        for (uint32_t x = box.lo[0]; x < box.hi[0]; ++x, ++i) {
-          const uint64_t key = map.grid.keys().Key(x, y, z);
-          const double times[] = {t};
-          ASSERT_EQ(region[i], store->Predict({&key, 1}, times, {})[0]) << x << "," << y << "," << z;
-          ASSERT_EQ(bytes[i], model::QuantizeProbability(region[i])) << x << "," << y << "," << z;
-          const auto snapshot = store->Snapshot(key);
-          ++kinds[!snapshot ? 0 : !snapshot->is_static ? 3 : snapshot->static_state.value() == 1.0f ? 2 : 1];
-        }
-      }
-    }
-    for (size_t kind = 0; kind < 4; ++kind) EXPECT_GT(kinds[kind], 0u) << "kind " << kind;
-  }
+  ExpectBoxesEqualPoints(*store, map, boxes, t);
+  // The same after a reopening: the shards load their states from the checkpoint and the log.
+  store.reset();
+  store = OpenOrDie(map, dir.path());
+  ASSERT_NE(store, nullptr);
+  ExpectBoxesEqualPoints(*store, map, boxes, t);
 }
 
 TEST(MapStoreRegionTest, FlatBoxesOfWholeAndPartBricksEqualPointPredictions) {

@@ -45,6 +45,7 @@ Shard::Shard(const MapInfo& map, const model::ModelSettings& settings, std::uniq
       lossless_(map.lossless_sampling_period > 0),
       grid_keys_(map.grid.keys()),
       env_(std::move(env)),
+      layout_(map.kind == MapKind::kGrid ? std::optional<BrickLayout>(grid_keys_) : std::nullopt),
       spectra_(settings.periods.size()),
       wide_(settings.periods.size()),
       widen_at_(widen_records_at),
@@ -96,6 +97,7 @@ Shard::Brick& Shard::BrickFor(uint64_t key) {
         brick_data_.emplace_back();
         brick_data_.back().handles.fill(kNone);
         brick_data_.back().chunk_base.fill(kNone);
+        if (layout_) images_.emplace_back();
       }
       index = it->second;
     }
@@ -445,21 +447,34 @@ Shard::BoxWalk Shard::WalkOf(const CellBox& box) const {
     if (i < bs[1]) walk.spread_y[i] = grid_keys_.LocalIndex(0, i, 0);
     if (i < bs[2]) walk.spread_z[i] = grid_keys_.LocalIndex(0, 0, i);
   }
-  // One hash lookup per brick.
+  // One lookup per brick: in the directory, or the hash table when the grid has none.
   for (uint32_t bz = box.lo[2] / bs[2]; bz <= (box.hi[2] - 1) / bs[2]; ++bz) {
     for (uint32_t by = box.lo[1] / bs[1]; by <= (box.hi[1] - 1) / bs[1]; ++by) {
       for (uint32_t bx = box.lo[0] / bs[0]; bx <= (box.hi[0] - 1) / bs[0]; ++bx) {
-        const auto it = bricks_.find(BrickOf(grid_keys_.Key(bx * bs[0], by * bs[1], bz * bs[2])));
-        if (it != bricks_.end()) walk.bricks.push_back({&brick_data_[it->second], bx, by, bz});
+        const uint64_t brick = BrickOf(grid_keys_.Key(bx * bs[0], by * bs[1], bz * bs[2]));
+        int64_t index = DirectoryLookup(brick);
+        if (index < 0 && brick_directory_.empty()) {
+          const auto it = bricks_.find(brick);
+          if (it != bricks_.end()) index = it->second;
+        }
+        if (index < 0) continue;
+        const BrickImage* image = layout_ ? &images_[index] : nullptr;
+        walk.bricks.push_back({&brick_data_[index], image, bx, by, bz});
       }
     }
   }
-  walk.PrefetchHandles(0);
   return walk;
 }
 
 void Shard::BoxWalk::PrefetchHandles(size_t b) const {
   if (b < bricks.size()) model::PrefetchForRead(bricks[b].brick->handles.data(), sizeof(Brick::handles));
+}
+
+void Shard::BoxWalk::PrefetchImage(size_t b) const {
+  if (b >= bricks.size()) return;
+  const BrickImage& image = *bricks[b].image;
+  model::PrefetchForRead(image.bytes(), 512);
+  model::PrefetchForRead(image.dynamic().data(), image.dynamic().size() * sizeof(BrickImage::DynamicCell));
 }
 
 Shard::BoxWalk::Cells Shard::BoxWalk::CellsIn(const CellBox& box, size_t b) const {
@@ -478,6 +493,7 @@ void Shard::ForEachBoxCell(const CellBox& box, Visit visit, EndBrick end_brick) 
   const BoxWalk walk = WalkOf(box);
   const std::array<uint32_t, 3> bs = walk.brick_size;
   const uint32_t mask_x = bs[0] - 1;  // brick sides are powers of two
+  walk.PrefetchHandles(0);
   for (size_t b = 0; b < walk.bricks.size(); ++b) {
     walk.PrefetchHandles(b + 1);
     const Brick* brick = walk.bricks[b].brick;
@@ -577,9 +593,9 @@ void Shard::PredictBoxConstant(const CellBox& box, const model::PhasorTable& tab
       });
 }
 
-// PredictRegion's hot path keeps its own loop: sharing PredictBoxConstant's brick walk
-// (ForEachBoxCell) made a 1M-cell UINT8 region's median 1.4-1.7x slower (fremen_query_load, two
-// pairs interleaved with main's fremend).
+// PredictRegion's hot path keeps its own loop over the bricks' images (storage/brick_region.h),
+// not PredictBoxConstant's walk over handles (ForEachBoxCell): a cell's handle read and turned into
+// p was most of a 1M-cell region's time.
 template <typename T>
 void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options, T* out,
                        uint8_t* held) const {
@@ -588,66 +604,84 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   const uint64_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
   const BoxWalk walk = WalkOf(box);
   const std::array<uint32_t, 3> bs = walk.brick_size;
-  const uint32_t mask_x = bs[0] - 1;  // brick sides are powers of two
   // The cells whose state has a published model — nearly all dynamic ones, on a map in use — go
-  // through the region kernel together, a brick at a time; the others are answered one by one.
-  // The brick's dynamic states are gathered first, their records prefetched for the kernel, then
-  // told apart by the published bits kept beside the records (CompactModels::published), which
-  // read no record (a miss per dynamic cell, one after another, was most of a 1M-cell region's
-  // samples when the check read the record's header).
-  std::array<uint32_t, 512> dynamic, published;
-  std::array<T*, 512> dynamic_cells, published_cells;
+  // through the region kernel together, a brick at a time, their records prefetched as they are
+  // gathered; the others are answered one by one. They are told apart by the published bits kept
+  // beside the records (CompactModels::published), which read no record (a miss per dynamic cell,
+  // one after another, was most of a 1M-cell region's samples when the check read the record's
+  // header).
+  std::array<uint32_t, 512> published, others;
+  std::array<T*, 512> published_cells, other_cells;
   std::array<float, 512> predicted;
-  // A brick wholly in the box goes sixteen cells at a time (BrickRegion), one partly in it cell by
-  // cell.
-  static_assert(BrickRegion::kNoHandle == kNone && BrickRegion::kNeverChanged == kStaticHandle,
-                "BrickRegion reads the shard's handles");
-  std::optional<BrickRegion> whole_bricks;  // made at the first whole brick
+  // Where each cell of a brick wholly in the box sits, from the brick's first cell.
+  std::array<int64_t, 512> offset;
+  for (uint32_t i = 0; i < 512; ++i) {
+    offset[i] = static_cast<int64_t>((uint64_t{layout_->Z(i)} * ny + layout_->Y(i)) * nx + layout_->X(i));
+  }
+  static_assert(BrickImage::kNoHandle == kNone && BrickImage::kNeverChanged == kStaticHandle,
+                "a brick's image is kept from the shard's handles");
   const BoxBricks box_bricks(box, bs);
+  walk.PrefetchImage(0);
   for (size_t b = 0; b < walk.bricks.size(); ++b) {
-    walk.PrefetchHandles(b + 1);
-    const Brick* brick = walk.bricks[b].brick;
-    if (held != nullptr) held[box_bricks.Index(walk.bricks[b].bx, walk.bricks[b].by, walk.bricks[b].bz)] = 1;
+    walk.PrefetchImage(b + 1);
+    const BoxWalk::BoxBrick& brick = walk.bricks[b];
+    const BrickImage& image = *brick.image;
+    if (held != nullptr) held[box_bricks.Index(brick.bx, brick.by, brick.bz)] = 1;
+    // The brick's cells in the box, [lo, hi) in the brick's own coordinates.
     const BoxWalk::Cells c = walk.CellsIn(box, b);
-    size_t m = 0;
-    if (c.hi[0] - c.lo[0] == bs[0] && c.hi[1] - c.lo[1] == bs[1] && c.hi[2] - c.lo[2] == bs[2]) {
-      if (!whole_bricks) whole_bricks.emplace(grid_keys_, nx, ny);
-      T* origin = out + ((c.lo[2] - box.lo[2]) * ny + (c.lo[1] - box.lo[1])) * nx + (c.lo[0] - box.lo[0]);
-      whole_bricks->Write(brick->handles.data(), origin,
-                          [&](uint32_t handle, T* cell) ABSL_NO_THREAD_SAFETY_ANALYSIS {  // under the lock above
-                            __builtin_prefetch(models_.record(handle));
-                            dynamic[m] = handle;
-                            dynamic_cells[m++] = cell;
-                          });
-    } else {  // a part of a brick
-      for (uint32_t z = c.lo[2]; z < c.hi[2]; ++z) {
-        for (uint32_t y = c.lo[1]; y < c.hi[1]; ++y) {
-          T* row = out + ((z - box.lo[2]) * ny + (y - box.lo[1])) * nx - box.lo[0];
-          const uint32_t yz = walk.spread_y[y & (bs[1] - 1)] | walk.spread_z[z & (bs[2] - 1)];
-          for (uint32_t x = c.lo[0]; x < c.hi[0]; ++x) {
-            const uint32_t handle = brick->handles[yz | walk.spread_x[x & mask_x]];
-            if (handle & kStaticHandle) {  // kNone among them: 0.5
-              row[x] = CellValue<T>(PredictHandle(handle, table, options));
-            } else {
-              __builtin_prefetch(models_.record(handle));
-              dynamic[m] = handle;
-              dynamic_cells[m++] = &row[x];
-            }
-          }
-        }
+    const std::array<uint32_t, 3> first = {brick.bx * bs[0], brick.by * bs[1], brick.bz * bs[2]};
+    std::array<uint32_t, 3> lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = c.lo[a] - first[a];
+      hi[a] = c.hi[a] - first[a];
+    }
+    // The never-changed and unobserved cells, a row at a time.
+    const uint32_t row_cells = hi[0] - lo[0];
+    T* plane = out + ((c.lo[2] - box.lo[2]) * ny + (c.lo[1] - box.lo[1])) * nx + (c.lo[0] - box.lo[0]);
+    for (uint32_t z = lo[2]; z < hi[2]; ++z, plane += nx * ny) {
+      T* row = plane;
+      for (uint32_t y = lo[1], i = (z * bs[1] + y) * bs[0] + lo[0]; y < hi[1]; ++y, row += nx, i += bs[0]) {
+        image.CopyRow(i, row_cells, row);
       }
     }
-    size_t n = 0;
-    for (size_t i = 0; i < m; ++i) {
-      if (models_.published(dynamic[i])) {
-        published[n] = dynamic[i];
-        published_cells[n++] = dynamic_cells[i];
+    // The dynamic ones: each brick's first cell is at `origin` in the box (before the box's start
+    // when the brick begins outside it, so an index, not a pointer).
+    const int64_t ox = int64_t{first[0]} - box.lo[0], oy = int64_t{first[1]} - box.lo[1],
+                  oz = int64_t{first[2]} - box.lo[2];
+    const int64_t origin = (oz * static_cast<int64_t>(ny) + oy) * static_cast<int64_t>(nx) + ox;
+    // Into two lists, written after the loop: a store through T* inside it would make the compiler
+    // reload the models' fields at each cell.
+    size_t n = 0, m = 0;
+    const auto gather = [&](uint32_t handle, T* at) ABSL_NO_THREAD_SAFETY_ANALYSIS {  // under the lock above
+      if (models_.published(handle)) {
+        __builtin_prefetch(models_.record(handle));  // for the kernel, after the brick's last
+        published[n] = handle;
+        published_cells[n++] = at;
       } else {
-        *dynamic_cells[i] = CellValue<T>(PredictHandle(dynamic[i], table, options));
+        others[m] = handle;
+        other_cells[m++] = at;
+      }
+    };
+    if (row_cells == bs[0] && hi[1] - lo[1] == bs[1] && hi[2] - lo[2] == bs[2]) {  // the whole brick
+      T* const first_cell = out + origin;
+      for (const BrickImage::DynamicCell& cell : image.dynamic()) gather(cell.handle, first_cell + offset[cell.cell]);
+    } else {
+      for (const BrickImage::DynamicCell& cell : image.dynamic()) {
+        const uint32_t x = layout_->X(cell.cell), y = layout_->Y(cell.cell), z = layout_->Z(cell.cell);
+        if (x < lo[0] || x >= hi[0] || y < lo[1] || y >= hi[1] || z < lo[2] || z >= hi[2]) continue;
+        gather(cell.handle, out + (origin + offset[cell.cell]));
       }
     }
+    for (size_t i = 0; i < m; ++i) *other_cells[i] = CellValue<T>(PredictHandle(others[i], table, options));
     PredictPublished({published.data(), n}, table, options, predicted.data());
-    for (size_t i = 0; i < n; ++i) *published_cells[i] = CellValue<T>(predicted[i]);
+    if constexpr (std::is_same_v<T, uint8_t>) {
+      // Quantised together (a vector loop), then scattered.
+      std::array<uint8_t, 512> bytes;
+      for (size_t i = 0; i < n; ++i) bytes[i] = CellValue<uint8_t>(predicted[i]);
+      for (size_t i = 0; i < n; ++i) *published_cells[i] = bytes[i];
+    } else {
+      for (size_t i = 0; i < n; ++i) *published_cells[i] = predicted[i];
+    }
   }
 }
 template void Shard::PredictBox(const CellBox&, const model::PhasorTable&, const PredictOptions&, float*,
@@ -720,6 +754,7 @@ ShardStats Shard::Stats() const {
                        persistence_.capacity() * sizeof(model::Persistence) +
                        slots_.capacity() * sizeof(Slot) +
                        brick_data_.capacity() * sizeof(Brick);
+  for (const BrickImage& image : images_) stats.memory_bytes += image.memory_bytes();
   if (auto used = env_->UsedBytes(); used.ok()) stats.disk_bytes = *used;
   return stats;
 }

@@ -43,6 +43,7 @@
 #include "absl/status/statusor.h"
 #include "base/mutex.h"
 #include "storage/batch.h"
+#include "storage/brick_region.h"
 #include "storage/dedup_table.h"
 #include "storage/lmdb/lmdb_env.h"
 #include "storage/map_info.h"
@@ -139,7 +140,7 @@ class Shard {
   // Writes p(t) of every cell of `box` in a brick this shard holds into out[index of the cell in
   // the box] (x fastest, then y, then z), unobserved cells of those bricks included; other cells
   // are left as they are. T: float, or uint8_t for p quantised (CellValue,
-  // storage/brick_region.h). `held` (when not null): held[i] = 1 for each of those bricks, i its
+  // storage/brick_region.h), from the bricks' images. `held` (when not null): held[i] = 1 for each of those bricks, i its
   // number in BoxBricks(box, brick size), so that the caller fills only the others.
   template <typename T>
   void PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options, T* out,
@@ -203,8 +204,10 @@ class Shard {
   uint32_t ReserveSlot(uint64_t key) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
   // ReserveSlot of every key into slots[i].
   void ReserveSlots(std::span<const uint64_t> keys, uint32_t* slots) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
+  // The only writer of handles, so that a grid's brick images follow them.
   void SetHandle(uint64_t key, uint32_t handle) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_) {
     BrickFor(key).handles[key & 511] = handle;
+    if (layout_) images_[cached_brick_index_].Set(layout_->RowMajor(key & 511), handle);
   }
   // Static → dynamic; returns the dynamic index.
   uint32_t Promote(uint32_t slot) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
@@ -236,6 +239,7 @@ class Shard {
   struct BoxWalk {
     struct BoxBrick {
       const Brick* brick;
+      const BrickImage* image;
       uint32_t bx, by, bz;
     };
     std::array<uint32_t, 3> brick_size;
@@ -243,6 +247,8 @@ class Shard {
     std::vector<BoxBrick> bricks;
     // A brick's handles (2 KB) are cold: the walk fetches the next brick's while it visits one.
     void PrefetchHandles(size_t b) const;
+    // The same for the next brick's image (512 bytes and its dynamic cells).
+    void PrefetchImage(size_t b) const;
     // The cells of `box` in brick b: [lo[a], hi[a]) on each axis a.
     struct Cells {
       std::array<uint32_t, 3> lo, hi;
@@ -295,6 +301,10 @@ class Shard {
 
   absl::flat_hash_map<uint64_t, uint32_t> bricks_ ABSL_GUARDED_BY(mutex_);  // brick → index into bricks_data_
   std::vector<Brick> brick_data_ ABSL_GUARDED_BY(mutex_);
+  // A grid's bricks as regions read them (storage/brick_region.h), images_[i] for brick_data_[i],
+  // kept by SetHandle; none for a generic map.
+  const std::optional<BrickLayout> layout_;
+  std::vector<BrickImage> images_ ABSL_GUARDED_BY(mutex_);
   // The same as bricks_ as an array, brick → index or kNone, for a grid whose keys span at most
   // kMaxDirectoryBricks bricks (a 2-D grid up to 16k × 16k cells; empty otherwise): a batched
   // Predict's scattered cells are looked up without a hash and a probe each (docs/performance.md,
