@@ -80,7 +80,8 @@ void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& bo
   auto store = OpenOrDie(map, dir.path());
   // A first few scans, then the rest, which observe more cells and change more of them.
   const double t = 1.7e9 + 3600.0 * 90;
-  for (uint64_t i = 0; i < 6; ++i) ASSERT_TRUE(store->Write(Scan(map, i, std::min(observed_x, map.grid.size[0]) / 2)).ok());
+  const uint32_t first_observed_x = std::min(observed_x, map.grid.size[0]) / 2;
+  for (uint64_t i = 0; i < 6; ++i) ASSERT_TRUE(store->Write(Scan(map, i, first_observed_x)).ok());
   for (uint64_t i = 6; i < 72; ++i) ASSERT_TRUE(store->Write(Scan(map, i, observed_x)).ok());
   ASSERT_TRUE(store->PublishModels().ok());
   ExpectBoxesEqualPoints(*store, map, boxes, t);

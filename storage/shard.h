@@ -139,9 +139,9 @@ class Shard {
   float Predict(uint64_t key, const model::PhasorTable& table, const PredictOptions& options) const;
   // Writes p(t) of every cell of `box` in a brick this shard holds into out[index of the cell in
   // the box] (x fastest, then y, then z), unobserved cells of those bricks included; other cells
-  // are left as they are. T: float, or uint8_t for p quantised (CellValue,
-  // storage/brick_region.h), from the bricks' images. `held` (when not null): held[i] = 1 for each of those bricks, i its
-  // number in BoxBricks(box, brick size), so that the caller fills only the others.
+  // are left as they are, from the bricks' images. T: float, or uint8_t for p quantised
+  // (CellValue, storage/brick_region.h). `held` (when not null): held[i] = 1 for each of those
+  // bricks, i its number in BoxBricks(box, brick size), so that the caller fills only the others.
   template <typename T>
   void PredictBox(const CellBox& box, const model::PhasorTable& table, const PredictOptions& options, T* out,
                   uint8_t* held = nullptr) const;
