@@ -1,5 +1,7 @@
 #include "storage/brick_region.h"
 
+#include <bit>
+
 namespace fremen::storage {
 
 BoxBricks::BoxBricks(const CellBox& box, const std::array<uint32_t, 3>& brick_size) : box_(box), brick_size_(brick_size) {

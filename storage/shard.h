@@ -138,8 +138,8 @@ class Shard {
   // p(t) of one state (kUnobservedProbability when never observed).
   float Predict(uint64_t key, const model::PhasorTable& table, const PredictOptions& options) const;
   // Writes p(t) of every cell of `box` in a brick this shard holds into out[index of the cell in
-  // the box] (x fastest, then y, then z), unobserved cells of those bricks included; other cells
-  // are left as they are, from the bricks' images. T: float, or uint8_t for p quantised
+  // the box] (x fastest, then y, then z), unobserved cells of those bricks included, from the
+  // bricks' images; other cells are left as they are. T: float, or uint8_t for p quantised
   // (CellValue, storage/brick_region.h). `held` (when not null): held[i] = 1 for each of those
   // bricks, i its number in BoxBricks(box, brick size), so that the caller fills only the others.
   template <typename T>
