@@ -1,8 +1,10 @@
 // End-to-end tests of QueryService's predictions against the real fremend: Predict and
 // PredictRegion — answers equal to what the store computes for the same states, every output, the
-// bad-input rows that apply (each with its exact status code and the field named), regions larger
-// than one chunk, deadlines and cancellation of huge regions — and read-only tokens.
+// bad-input rows that apply (each with its exact status code and the field named; requests that
+// do not parse), regions larger than one chunk, deadlines and cancellation of huge regions — and
+// read-only tokens.
 #include <gmock/gmock.h>
+#include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -388,6 +390,55 @@ TEST_F(QueryServiceTest, RegionBadInput) {
   r = base();
   r.set_map("nowhere");
   EXPECT_STATUS(Region(r).status, NOT_FOUND, "nowhere");
+}
+
+// The region methods parse their own requests (they are raw, to write their values in place): a
+// request that is not the message gets INVALID_ARGUMENT naming it, and the daemon serves on.
+grpc::Status CallWithBytes(grpc::Channel& channel, const std::string& method, const std::string& request) {
+  grpc::GenericStub stub(channel.shared_from_this());
+  grpc::CompletionQueue queue;
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+  const auto call = stub.PrepareCall(&context, method, &queue);
+  const auto step = [&queue](int tag) {
+    void* got = nullptr;
+    bool ok = false;
+    EXPECT_TRUE(queue.Next(&got, &ok));
+    EXPECT_EQ(got, reinterpret_cast<void*>(static_cast<intptr_t>(tag)));
+    return ok;
+  };
+  const auto tag = [](int t) { return reinterpret_cast<void*>(static_cast<intptr_t>(t)); };
+  call->StartCall(tag(1));
+  step(1);
+  grpc::Slice slice(request);
+  call->WriteLast(grpc::ByteBuffer(&slice, 1), grpc::WriteOptions(), tag(2));
+  step(2);
+  grpc::ByteBuffer response;
+  call->Read(&response, tag(3));
+  EXPECT_FALSE(step(3)) << method << " answered a request that does not parse";
+  grpc::Status status;
+  call->Finish(&status, tag(4));
+  step(4);
+  queue.Shutdown();
+  return status;
+}
+
+TEST_F(QueryServiceTest, RegionRequestsThatDoNotParse) {
+  CreateMap(GridMap("lab", kNx, kNy));
+  const std::string truncated("\x0a\x05la", 4);  // field 1 (map): 5 bytes promised, 2 sent
+  const std::shared_ptr<grpc::Channel> channel = daemon_->NewChannel();
+  EXPECT_STATUS(CallWithBytes(*channel, "/fremen.v1.QueryService/PredictRegion", truncated), INVALID_ARGUMENT,
+                "fremen.v1.PredictRegionRequest");
+  EXPECT_STATUS(CallWithBytes(*channel, "/fremen.v1.QueryService/PredictRegionSeries", "\xff"), INVALID_ARGUMENT,
+                "fremen.v1.PredictRegionSeriesRequest");
+  // And a request that parses is answered.
+  v1::PredictRegionRequest whole;
+  whole.set_map("lab");
+  *whole.mutable_hi() = Cell(kNx, kNy);
+  whole.set_time(kT0);
+  const RegionResult region = Region(whole);
+  EXPECT_TRUE(region.status.ok()) << region.status.error_message();
+  EXPECT_EQ(Assemble<float>(region, kNx * kNy).size(), kNx * kNy);
 }
 
 // --- Authorization ---

@@ -1,5 +1,7 @@
 #include "server/services/block_stream.h"
 
+#include <grpcpp/impl/codegen/proto_utils.h>
+
 #include <chrono>
 
 #include "absl/strings/str_cat.h"
@@ -8,11 +10,19 @@
 namespace fremen::server {
 
 template <typename RequestT, typename ResponseT>
-void BlockStream<RequestT, ResponseT>::Begin(const Request& request) {
+void BlockStream<RequestT, ResponseT>::Begin(const grpc::ByteBuffer& raw_request) {
   absl::StatusOr<uint64_t> id = deps_.calls->BeginStream(drain_);
   absl::Status status = id.status();
   if (id.ok()) stream_id_ = *id;
   if (status.ok()) status = deps_.auth->Authorize(*context_, method_.access, method_.name);
+  Request request;
+  if (status.ok()) {
+    grpc::ByteBuffer buffer(raw_request);  // shares the slices; the parse consumes the copy
+    if (!grpc::SerializationTraits<Request>::Deserialize(&buffer, &request).ok()) {
+      status = absl::InvalidArgumentError(
+          absl::StrCat(method_.name, ": cannot parse the request as ", request.GetTypeName()));
+    }
+  }
   if (status.ok()) status = Prepare(request);
   if (!status.ok()) {
     {
@@ -43,7 +53,7 @@ absl::Status BlockStream<RequestT, ResponseT>::Interrupted() const {
 
 template <typename RequestT, typename ResponseT>
 void BlockStream<RequestT, ResponseT>::Pump() {
-  Response* to_write = nullptr;
+  grpc::ByteBuffer* to_write = nullptr;
   std::optional<uint64_t> to_compute;
   std::optional<absl::Status> to_finish;
   {
@@ -62,7 +72,7 @@ void BlockStream<RequestT, ResponseT>::Pump() {
         writing_ = true;
         in_flight_ = std::move(ready_.front());
         ready_.pop_front();
-        to_write = in_flight_.get();
+        to_write = &in_flight_.bytes;
       }
       // The next block while this one's chunks go out, unless a whole block's chunks still wait.
       if (!computing_ && next_block_ < block_count_ && ready_.size() < chunks_per_block_) {
@@ -90,19 +100,6 @@ void BlockStream<RequestT, ResponseT>::Pump() {
 }
 
 template <typename RequestT, typename ResponseT>
-std::unique_ptr<ResponseT> BlockStream<RequestT, ResponseT>::TakeBuffer() {
-  {
-    base::MutexLock lock(&mutex_);
-    if (!free_.empty()) {
-      std::unique_ptr<Response> buffer = std::move(free_.back());
-      free_.pop_back();
-      return buffer;
-    }
-  }
-  return std::make_unique<Response>();
-}
-
-template <typename RequestT, typename ResponseT>
 void BlockStream<RequestT, ResponseT>::Compute(uint64_t i) {
   // Skip the work when the client has gone meanwhile (the pool may have queued the block a while).
   absl::Status status = Interrupted();
@@ -124,8 +121,8 @@ void BlockStream<RequestT, ResponseT>::OnWriteDone(bool ok) {
   {
     base::MutexLock lock(&mutex_);
     writing_ = false;
-    values_sent_ += ValuesOf(*in_flight_);
-    free_.push_back(std::move(in_flight_));
+    values_sent_ += in_flight_.values;
+    in_flight_ = WireChunk();  // its buffer's memory back now, not at the next write
     if (!ok && error_.ok()) error_ = absl::CancelledError(absl::StrCat(method_.name, ": the client went away"));
   }
   Pump();

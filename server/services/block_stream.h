@@ -9,6 +9,10 @@
 // client has given up), and when the daemon drains for shutdown (UNAVAILABLE, which clients retry).
 // Like ServeUnary, the call is counted in the CallTracker, authorized, and logged once finished.
 //
+// The methods are raw (the service registers them with WithRawCallbackMethod_): the stream parses
+// its request and writes its chunks as serialized messages (server/services/wire_chunk.h), so that
+// a subclass may write a chunk's values where they go on the wire.
+//
 // Thread-safety: reactions (gRPC threads) and block computations (pool threads) meet under one
 // mutex; at most one computation and one write are in flight; Finish is called once, when neither
 // is, so that nothing touches the reactor after OnDone deletes it. ComputeBlock calls are one at a
@@ -29,13 +33,14 @@
 #include "base/mutex.h"
 #include "server/rpc/access_log.h"
 #include "server/rpc/unary_call.h"
+#include "server/services/wire_chunk.h"
 
 // Instantiated in block_stream.cc for the requests and responses of QueryService's streams.
 
 namespace fremen::server {
 
 template <typename RequestT, typename ResponseT>
-class BlockStream : public grpc::ServerWriteReactor<ResponseT> {
+class BlockStream : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
  public:
   using Request = RequestT;
   using Response = ResponseT;
@@ -45,20 +50,21 @@ class BlockStream : public grpc::ServerWriteReactor<ResponseT> {
   void OnDone() override;
 
  protected:
-  using Chunks = std::vector<std::unique_ptr<Response>>;
+  using Chunks = std::vector<WireChunk>;
 
   BlockStream(const ServiceDeps& deps, grpc::CallbackServerContext* context, const MethodSpec& method)
       : deps_(deps), context_(context), method_(method), record_(method.name, *context, deps.observer) {}
   virtual ~BlockStream() = default;
 
-  // Starts the call: counted, authorized, prepared (the subclass's checks and plan), then streamed
-  // or finished with the first error. The stream deletes itself once the call is done.
-  void Begin(const Request& request);
+  // Starts the call: counted, authorized, its request parsed (INVALID_ARGUMENT if it does not
+  // parse) and prepared (the subclass's checks and plan), then streamed or finished with the first
+  // error. The stream deletes itself once the call is done.
+  void Begin(const grpc::ByteBuffer& raw_request);
 
   // The subclass's part. Prepare checks the request and plans: it sets the blocks known so far
   // (SetBlocks) and the values the whole answer holds (set_total_values).
   virtual absl::Status Prepare(const Request& request) = 0;
-  // Computes block i into its chunks, in stream order (buffers from TakeBuffer); `more_blocks`: the
+  // Computes block i into its chunks, in stream order (ChunkOf, or ValuesInPlace); `more_blocks`: the
   // blocks it adds after the known ones (a plan that knows its size only once computed).
   virtual absl::Status ComputeBlock(uint64_t i, Chunks& chunks, uint64_t& more_blocks) = 0;
   // Whether block i is so small that the hop to the pool would cost more than the work.
@@ -70,7 +76,10 @@ class BlockStream : public grpc::ServerWriteReactor<ResponseT> {
     chunks_per_block_ = chunks_per_block;
   }
   void set_total_values(uint64_t total) { total_values_ = total; }
-  std::unique_ptr<Response> TakeBuffer() ABSL_LOCKS_EXCLUDED(mutex_);
+  // `response` as a chunk (serialized).
+  static absl::StatusOr<WireChunk> ChunkOf(const Response& response) {
+    return SerializedChunk(response, response.float_values_size() + response.bytes_values().size());
+  }
 
   const ServiceDeps deps_;
   grpc::CallbackServerContext* const context_;
@@ -83,7 +92,6 @@ class BlockStream : public grpc::ServerWriteReactor<ResponseT> {
   // Why the stream must stop now (cancelled, past its deadline, draining), or OK.
   absl::Status Interrupted() const;
   void FinishWith(const absl::Status& status);
-  static uint64_t ValuesOf(const Response& r) { return r.float_values_size() + r.bytes_values().size(); }
 
   const MethodSpec method_;
   const CallRecord record_;
@@ -106,9 +114,8 @@ class BlockStream : public grpc::ServerWriteReactor<ResponseT> {
   bool writing_ ABSL_GUARDED_BY(mutex_) = false;
   bool finished_ ABSL_GUARDED_BY(mutex_) = false;
   // Chunks computed, in order, not yet written.
-  std::deque<std::unique_ptr<Response>> ready_ ABSL_GUARDED_BY(mutex_);
-  std::unique_ptr<Response> in_flight_ ABSL_GUARDED_BY(mutex_);
-  std::vector<std::unique_ptr<Response>> free_ ABSL_GUARDED_BY(mutex_);
+  std::deque<WireChunk> ready_ ABSL_GUARDED_BY(mutex_);
+  WireChunk in_flight_ ABSL_GUARDED_BY(mutex_);
 };
 
 }  // namespace fremen::server

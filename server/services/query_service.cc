@@ -252,13 +252,13 @@ grpc::ServerUnaryReactor* QueryServiceImpl::Predict(grpc::CallbackServerContext*
   });
 }
 
-grpc::ServerWriteReactor<v1::PredictRegionResponse>* QueryServiceImpl::PredictRegion(
-    grpc::CallbackServerContext* context, const v1::PredictRegionRequest* request) {
+grpc::ServerWriteReactor<grpc::ByteBuffer>* QueryServiceImpl::PredictRegion(grpc::CallbackServerContext* context,
+                                                                           const grpc::ByteBuffer* request) {
   return RegionStream::Start(deps_, context, *request);
 }
 
-grpc::ServerWriteReactor<v1::PredictRegionSeriesResponse>* QueryServiceImpl::PredictRegionSeries(
-    grpc::CallbackServerContext* context, const v1::PredictRegionSeriesRequest* request) {
+grpc::ServerWriteReactor<grpc::ByteBuffer>* QueryServiceImpl::PredictRegionSeries(
+    grpc::CallbackServerContext* context, const grpc::ByteBuffer* request) {
   return RegionSeriesStream::Start(deps_, context, *request);
 }
 

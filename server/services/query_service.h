@@ -16,16 +16,20 @@
 
 namespace fremen::server {
 
-class QueryServiceImpl final : public v1::QueryService::CallbackService {
+// The region methods are raw: their streams parse the request and write serialized chunks
+// (server/services/block_stream.h).
+class QueryServiceImpl final
+    : public v1::QueryService::WithRawCallbackMethod_PredictRegion<
+          v1::QueryService::WithRawCallbackMethod_PredictRegionSeries<v1::QueryService::CallbackService>> {
  public:
   explicit QueryServiceImpl(const ServiceDeps& deps) : deps_(deps) {}
 
   grpc::ServerUnaryReactor* Predict(grpc::CallbackServerContext* context, const v1::PredictRequest* request,
                                     v1::PredictResponse* response) override;
-  grpc::ServerWriteReactor<v1::PredictRegionResponse>* PredictRegion(
-      grpc::CallbackServerContext* context, const v1::PredictRegionRequest* request) override;
-  grpc::ServerWriteReactor<v1::PredictRegionSeriesResponse>* PredictRegionSeries(
-      grpc::CallbackServerContext* context, const v1::PredictRegionSeriesRequest* request) override;
+  grpc::ServerWriteReactor<grpc::ByteBuffer>* PredictRegion(grpc::CallbackServerContext* context,
+                                                             const grpc::ByteBuffer* request) override;
+  grpc::ServerWriteReactor<grpc::ByteBuffer>* PredictRegionSeries(grpc::CallbackServerContext* context,
+                                                                   const grpc::ByteBuffer* request) override;
   grpc::ServerUnaryReactor* TopStates(grpc::CallbackServerContext* context, const v1::TopStatesRequest* request,
                                       v1::TopStatesResponse* response) override;
   grpc::ServerUnaryReactor* CheckAnomalies(grpc::CallbackServerContext* context,

@@ -21,7 +21,7 @@ RegionSeriesStream::RegionSeriesStream(const ServiceDeps& deps, grpc::CallbackSe
     : BlockStream(deps, context, kPredictRegionSeries) {}
 
 RegionSeriesStream* RegionSeriesStream::Start(const ServiceDeps& deps, grpc::CallbackServerContext* context,
-                                              const v1::PredictRegionSeriesRequest& request) {
+                                              const grpc::ByteBuffer& request) {
   auto* stream = new RegionSeriesStream(deps, context);
   stream->Begin(request);
   return stream;
@@ -62,13 +62,12 @@ bool RegionSeriesStream::ComputesInline(uint64_t i) const {
   return cells <= kInlineRegionCells;
 }
 
-std::unique_ptr<v1::PredictRegionSeriesResponse> RegionSeriesStream::NewChunk() {
-  std::unique_ptr<Response> chunk = TakeBuffer();
-  chunk->Clear();
-  chunk->set_box_cells(box_.cell_count());
-  chunk->set_varying_cells(plan_->varying.size());
-  chunk->set_time_count(static_cast<uint32_t>(times_.size()));
-  return chunk;
+v1::PredictRegionSeriesResponse& RegionSeriesStream::NewChunk() {
+  message_.Clear();
+  message_.set_box_cells(box_.cell_count());
+  message_.set_varying_cells(plan_->varying.size());
+  message_.set_time_count(static_cast<uint32_t>(times_.size()));
+  return message_;
 }
 
 absl::Status RegionSeriesStream::ComputeBase(Chunks& chunks) {
@@ -81,11 +80,11 @@ absl::Status RegionSeriesStream::ComputeBase(Chunks& chunks) {
   auto next_varying = varying.begin();
   for (uint64_t offset = 0; offset < box_.cell_count(); offset += per_chunk) {
     const uint64_t cells = std::min(per_chunk, box_.cell_count() - offset);
-    std::unique_ptr<Response> chunk = NewChunk();
-    chunk->set_base(true);
-    chunk->set_offset(offset);
-    chunk->set_cells(cells);
-    std::string& mask = *chunk->mutable_varying_mask();
+    Response& chunk = NewChunk();
+    chunk.set_base(true);
+    chunk.set_offset(offset);
+    chunk.set_cells(cells);
+    std::string& mask = *chunk.mutable_varying_mask();
     mask.assign(CeilDiv(cells, 8), '\0');
     scratch_.clear();
     // Runs of constant cells between the chunk's varying ones.
@@ -100,8 +99,10 @@ absl::Status RegionSeriesStream::ComputeBase(Chunks& chunks) {
       from = *next_varying + 1;
     }
     constant_run(offset + cells);
-    EncodeRegionValues(output_, confidence_, scratch_, *chunk);
-    chunks.push_back(std::move(chunk));
+    EncodeRegionValues(output_, confidence_, scratch_, chunk);
+    absl::StatusOr<WireChunk> encoded = ChunkOf(chunk);
+    if (!encoded.ok()) return encoded.status();
+    chunks.push_back(*std::move(encoded));
   }
   return absl::OkStatus();
 }
@@ -125,11 +126,13 @@ absl::Status RegionSeriesStream::ComputeBlock(uint64_t i, Chunks& chunks, uint64
     const std::span<const float> frame = std::span<const float>(scratch_).subspan(g * varying, varying);
     for (uint64_t offset = 0; offset < varying; offset += chunk_cells_) {
       const uint64_t n = std::min(chunk_cells_, varying - offset);
-      std::unique_ptr<Response> chunk = NewChunk();
-      chunk->set_time_index(static_cast<uint32_t>(first + g));
-      chunk->set_offset(offset);
-      EncodeRegionValues(output_, confidence_, frame.subspan(offset, n), *chunk);
-      chunks.push_back(std::move(chunk));
+      Response& chunk = NewChunk();
+      chunk.set_time_index(static_cast<uint32_t>(first + g));
+      chunk.set_offset(offset);
+      EncodeRegionValues(output_, confidence_, frame.subspan(offset, n), chunk);
+      absl::StatusOr<WireChunk> encoded = ChunkOf(chunk);
+      if (!encoded.ok()) return encoded.status();
+      chunks.push_back(*std::move(encoded));
     }
   }
   return absl::OkStatus();

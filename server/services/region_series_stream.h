@@ -39,7 +39,7 @@ class RegionSeriesStream final
  public:
   // Starts the call; the reactor deletes itself once the call is done.
   static RegionSeriesStream* Start(const ServiceDeps& deps, grpc::CallbackServerContext* context,
-                                   const v1::PredictRegionSeriesRequest& request);
+                                   const grpc::ByteBuffer& request);
 
  private:
   RegionSeriesStream(const ServiceDeps& deps, grpc::CallbackServerContext* context);
@@ -48,8 +48,8 @@ class RegionSeriesStream final
   bool ComputesInline(uint64_t i) const override;
   // Block 0: the plan and the base's chunks.
   absl::Status ComputeBase(Chunks& chunks);
-  // A chunk with the fields every message repeats.
-  std::unique_ptr<Response> NewChunk();
+  // message_, cleared, with the fields every message repeats.
+  Response& NewChunk();
 
   // Fixed by Prepare.
   std::shared_ptr<storage::MapStore> map_;
@@ -63,7 +63,9 @@ class RegionSeriesStream final
   // Block 0's, read by the later blocks (one computation at a time, in order).
   std::optional<storage::BoxSeries> plan_;
   uint64_t times_per_block_ = 1;
-  std::vector<float> scratch_;  // the computing thread's
+  // The computing thread's.
+  std::vector<float> scratch_;
+  Response message_;  // the chunk being made
 };
 
 }  // namespace fremen::server

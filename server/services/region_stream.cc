@@ -18,7 +18,7 @@ RegionStream::RegionStream(const ServiceDeps& deps, grpc::CallbackServerContext*
     : BlockStream(deps, context, kPredictRegion) {}
 
 RegionStream* RegionStream::Start(const ServiceDeps& deps, grpc::CallbackServerContext* context,
-                                  const v1::PredictRegionRequest& request) {
+                                  const grpc::ByteBuffer& request) {
   auto* stream = new RegionStream(deps, context);
   stream->Begin(request);
   return stream;
@@ -51,38 +51,32 @@ absl::Status RegionStream::ComputeBlock(uint64_t i, Chunks& chunks, uint64_t& /*
   // A block is a run of the box's cells in the box's order, and so is each chunk of the block.
   const RegionPlan plan(block.box, chunk_cells_);
   const bool floats = output_ == v1::REGION_OUTPUT_FLOAT, bytes = output_ == v1::REGION_OUTPUT_UINT8;
-  // Floats and bytes are predicted straight into each chunk's response (bytes quantised by the
-  // shards as they write); the other outputs are computed from the block's p, predicted once into
-  // scratch_.
+  // Floats and bytes are predicted straight into each chunk's place on the wire (bytes quantised by
+  // the shards as they write); the other outputs are computed from the block's p, predicted once
+  // into scratch_.
   if (!floats && !bytes) {
     if (absl::Status s = map_->PredictBox(block.box, time_, options_, scratch_); !s.ok()) return s;
   }
   for (uint64_t j = 0; j < plan.chunk_count(); ++j) {
     const RegionPlan::Chunk chunk = plan.chunk(j);
-    std::unique_ptr<Response> buffer = TakeBuffer();
-    buffer->set_offset(block.offset + chunk.offset);
-    buffer->set_box_cells(blocks_->box_cells());
-    if (floats) {
-      // Room for the chunk's values, written once, by the prediction (a buffer keeps its capacity).
-      google::protobuf::RepeatedField<float>& values = *buffer->mutable_float_values();
-      values.Clear();
-      values.Reserve(static_cast<int>(chunk.box.cell_count()));
-      float* out = values.AddNAlreadyReserved(static_cast<int>(chunk.box.cell_count()));
-      if (absl::Status s = map_->PredictBox(chunk.box, time_, options_, {out, chunk.box.cell_count()}); !s.ok()) {
-        return s;
-      }
-      buffer->clear_bytes_values();
-    } else if (bytes) {
-      buffer->clear_float_values();
-      std::string& values = *buffer->mutable_bytes_values();
-      values.resize(chunk.box.cell_count());
-      const std::span<uint8_t> out(reinterpret_cast<uint8_t*>(values.data()), values.size());
-      if (absl::Status s = map_->PredictBox(chunk.box, time_, options_, out); !s.ok()) return s;
-    } else {
-      EncodeRegionValues(output_, confidence_,
-                         std::span<const float>(scratch_).subspan(chunk.offset, chunk.box.cell_count()), *buffer);
+    const uint64_t cells = chunk.box.cell_count();
+    message_.Clear();
+    message_.set_offset(block.offset + chunk.offset);
+    message_.set_box_cells(blocks_->box_cells());
+    if (floats || bytes) {
+      ValuesInPlace values(message_, floats ? Response::kFloatValuesFieldNumber : Response::kBytesValuesFieldNumber,
+                           floats ? cells * sizeof(float) : cells);
+      const absl::Status s = floats ? map_->PredictBox(chunk.box, time_, options_, values.floats())
+                                    : map_->PredictBox(chunk.box, time_, options_, values.bytes());
+      if (!s.ok()) return s;
+      chunks.push_back(std::move(values).Finish(cells));
+      continue;
     }
-    chunks.push_back(std::move(buffer));
+    EncodeRegionValues(output_, confidence_, std::span<const float>(scratch_).subspan(chunk.offset, cells),
+                       message_);
+    absl::StatusOr<WireChunk> encoded = ChunkOf(message_);
+    if (!encoded.ok()) return encoded.status();
+    chunks.push_back(*std::move(encoded));
   }
   return absl::OkStatus();
 }

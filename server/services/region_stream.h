@@ -3,7 +3,7 @@
 //
 // The box is computed a block at a time (up to 256k cells: one MapStore::PredictBox call, which
 // spreads it over the map's shards), and each block is cut into chunks of at most 1 MiB, the
-// messages.
+// messages. Floats and bytes are predicted into the chunk's own buffer, the one gRPC sends.
 //
 // Thread-safety: as BlockStream's.
 #pragma once
@@ -25,7 +25,7 @@ class RegionStream final : public BlockStream<v1::PredictRegionRequest, v1::Pred
  public:
   // Starts the call; the reactor deletes itself once the call is done.
   static RegionStream* Start(const ServiceDeps& deps, grpc::CallbackServerContext* context,
-                             const v1::PredictRegionRequest& request);
+                             const grpc::ByteBuffer& request);
 
  private:
   RegionStream(const ServiceDeps& deps, grpc::CallbackServerContext* context);
@@ -42,7 +42,9 @@ class RegionStream final : public BlockStream<v1::PredictRegionRequest, v1::Pred
   v1::RegionOutput output_ = v1::REGION_OUTPUT_FLOAT;
   float confidence_ = 0.5f;
 
-  std::vector<float> scratch_;  // the computing thread's (one at a time)
+  // The computing thread's (one at a time).
+  std::vector<float> scratch_;
+  Response message_;  // a chunk's fields
 };
 
 }  // namespace fremen::server
