@@ -64,7 +64,7 @@ class BlockStream : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
   // The subclass's part. Prepare checks the request and plans: it sets the blocks known so far
   // (SetBlocks) and the values the whole answer holds (set_total_values).
   virtual absl::Status Prepare(const Request& request) = 0;
-  // Computes block i into its chunks, in stream order (ChunkOf, or ValuesInPlace); `more_blocks`: the
+  // Computes block i into its chunks, in stream order (AddChunk, or ValuesInPlace); `more_blocks`: the
   // blocks it adds after the known ones (a plan that knows its size only once computed).
   virtual absl::Status ComputeBlock(uint64_t i, Chunks& chunks, uint64_t& more_blocks) = 0;
   // Whether block i is so small that the hop to the pool would cost more than the work.
@@ -76,9 +76,13 @@ class BlockStream : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
     chunks_per_block_ = chunks_per_block;
   }
   void set_total_values(uint64_t total) { total_values_ = total; }
-  // `response` as a chunk (serialized).
-  static absl::StatusOr<WireChunk> ChunkOf(const Response& response) {
-    return SerializedChunk(response, response.float_values_size() + response.bytes_values().size());
+  // Appends `response`, serialized, to `chunks`.
+  static absl::Status AddChunk(const Response& response, Chunks& chunks) {
+    absl::StatusOr<WireChunk> chunk =
+        SerializedChunk(response, response.float_values_size() + response.bytes_values().size());
+    if (!chunk.ok()) return chunk.status();
+    chunks.push_back(*std::move(chunk));
+    return absl::OkStatus();
   }
 
   const ServiceDeps deps_;

@@ -100,9 +100,7 @@ absl::Status RegionSeriesStream::ComputeBase(Chunks& chunks) {
     }
     constant_run(offset + cells);
     EncodeRegionValues(output_, confidence_, scratch_, chunk);
-    absl::StatusOr<WireChunk> encoded = ChunkOf(chunk);
-    if (!encoded.ok()) return encoded.status();
-    chunks.push_back(*std::move(encoded));
+    if (absl::Status s = AddChunk(chunk, chunks); !s.ok()) return s;
   }
   return absl::OkStatus();
 }
@@ -130,9 +128,7 @@ absl::Status RegionSeriesStream::ComputeBlock(uint64_t i, Chunks& chunks, uint64
       chunk.set_time_index(static_cast<uint32_t>(first + g));
       chunk.set_offset(offset);
       EncodeRegionValues(output_, confidence_, frame.subspan(offset, n), chunk);
-      absl::StatusOr<WireChunk> encoded = ChunkOf(chunk);
-      if (!encoded.ok()) return encoded.status();
-      chunks.push_back(*std::move(encoded));
+      if (absl::Status s = AddChunk(chunk, chunks); !s.ok()) return s;
     }
   }
   return absl::OkStatus();

@@ -74,9 +74,7 @@ absl::Status RegionStream::ComputeBlock(uint64_t i, Chunks& chunks, uint64_t& /*
     }
     EncodeRegionValues(output_, confidence_, std::span<const float>(scratch_).subspan(chunk.offset, cells),
                        message_);
-    absl::StatusOr<WireChunk> encoded = ChunkOf(message_);
-    if (!encoded.ok()) return encoded.status();
-    chunks.push_back(*std::move(encoded));
+    if (absl::Status s = AddChunk(message_, chunks); !s.ok()) return s;
   }
   return absl::OkStatus();
 }
