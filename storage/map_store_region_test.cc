@@ -1,8 +1,10 @@
 // MapStore::PredictBox over boxes that hold whole bricks and parts of bricks, as floats and as
 // bytes: every cell must be what a point prediction gives (a byte, its quantisation), for a flat
 // and a cubic grid, with never-changed cells at 0 and at 1, unobserved cells, and dynamic ones with
-// and without a published model — after the cells have changed kind between two regions, and
-// after a reopening (the bricks' images, storage/brick_region.h, follow every handle).
+// and without a published model — after the cells have changed kind between two regions, after a
+// publication that changes the models (the shards' copy of them brick by brick,
+// storage/brick_models.h, is then out of date), at a fixed order and with persistence, and after a
+// reopening (the bricks' images, storage/brick_region.h, follow every handle).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -24,12 +26,13 @@ using fremen::testing::TempDir;
 // Scan i: about 3/4 of the cells with x < observed_x (the rest stay unobserved); cells with
 // x % 7 == 0 follow a daily square wave, the others keep one value for ever, 1 where
 // (x + 2y + z) % 3 == 0, else 0.
-ObservationBatch Scan(const MapInfo& map, uint64_t i, uint32_t observed_x) {
+// With `inverted`, the wave is high at night instead.
+ObservationBatch Scan(const MapInfo& map, uint64_t i, uint32_t observed_x, bool inverted = false) {
   ObservationBatch b;
   b.writer_id = 1;
   b.sequence = i + 1;
   b.time = 1.7e9 + 3600.0 * static_cast<double>(i);
-  const bool day = std::fmod(b.time, 86400.0) < 43200.0;
+  const bool day = (std::fmod(b.time, 86400.0) < 43200.0) != inverted;
   const std::array<uint32_t, 3> size = map.grid.size;
   for (uint32_t z = 0; z < size[2]; ++z) {
     for (uint32_t y = 0; y < size[1]; ++y) {
@@ -47,14 +50,15 @@ ObservationBatch Scan(const MapInfo& map, uint64_t i, uint32_t observed_x) {
 }
 
 // Each box at time t, as floats and as bytes, against the point predictions of its cells.
-void ExpectBoxesEqualPoints(const MapStore& store, const MapInfo& map, const std::vector<CellBox>& boxes, double t) {
+void ExpectBoxesEqualPoints(const MapStore& store, const MapInfo& map, const std::vector<CellBox>& boxes, double t,
+                            const PredictOptions& options = {}) {
   for (const CellBox& box : boxes) {
     std::vector<float> region(box.cell_count(), 7.0f);  // every cell must be written
-    ASSERT_TRUE(store.PredictBox(box, t, {}, region).ok());
+    ASSERT_TRUE(store.PredictBox(box, t, options, region).ok());
     ASSERT_EQ(region.size(), box.cell_count());
     // The same box as bytes (the UINT8 region), quantised by the shards as they write.
     std::vector<uint8_t> bytes(box.cell_count(), 77);
-    ASSERT_TRUE(store.PredictBox(box, t, {}, std::span<uint8_t>(bytes)).ok());
+    ASSERT_TRUE(store.PredictBox(box, t, options, std::span<uint8_t>(bytes)).ok());
     size_t i = 0;
     size_t kinds[4] = {};  // unobserved, never changed at 0, at 1, dynamic
     for (uint32_t z = box.lo[2]; z < box.hi[2]; ++z) {
@@ -62,7 +66,7 @@ void ExpectBoxesEqualPoints(const MapStore& store, const MapInfo& map, const std
         for (uint32_t x = box.lo[0]; x < box.hi[0]; ++x, ++i) {
           const uint64_t key = map.grid.keys().Key(x, y, z);
           const double times[] = {t};
-          ASSERT_EQ(region[i], store.Predict({&key, 1}, times, {})[0]) << x << "," << y << "," << z;
+          ASSERT_EQ(region[i], store.Predict({&key, 1}, times, options)[0]) << x << "," << y << "," << z;
           ASSERT_EQ(bytes[i], model::QuantizeProbability(region[i])) << x << "," << y << "," << z;
           const auto snapshot = store.Snapshot(key);
           ++kinds[!snapshot ? 0 : !snapshot->is_static ? 3 : snapshot->static_state.value() == 1.0f ? 2 : 1];
@@ -84,7 +88,11 @@ void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& bo
   for (uint64_t i = 0; i < 6; ++i) ASSERT_TRUE(store->Write(Scan(map, i, first_observed_x)).ok());
   for (uint64_t i = 6; i < 72; ++i) ASSERT_TRUE(store->Write(Scan(map, i, observed_x)).ok());
   ASSERT_TRUE(store->PublishModels().ok());
+  // The first region makes the shards' copy of their models brick by brick, which the memory
+  // figure counts.
+  const uint64_t memory_before = store->Stats().totals.memory_bytes;
   ExpectBoxesEqualPoints(*store, map, boxes, t);
+  EXPECT_GT(store->Stats().totals.memory_bytes, memory_before);
   // Then dynamic states without a published model: cells that change only after the publication.
   ObservationBatch late;
   late.writer_id = 2;
@@ -100,6 +108,12 @@ void ExpectRegionsEqualPoints(const MapInfo& map, const std::vector<CellBox>& bo
   ASSERT_FALSE(late.keys.empty());
   ASSERT_TRUE(store->Write(std::move(late)).ok());
   ExpectBoxesEqualPoints(*store, map, boxes, t);
+  // The wave turned round, and published: every published model changes.
+  for (uint64_t i = 81; i < 153; ++i) ASSERT_TRUE(store->Write(Scan(map, i, observed_x, /*inverted=*/true)).ok());
+  ASSERT_TRUE(store->PublishModels().ok());
+  ExpectBoxesEqualPoints(*store, map, boxes, t);
+  ExpectBoxesEqualPoints(*store, map, boxes, t, {.order = 1});
+  ExpectBoxesEqualPoints(*store, map, boxes, t, {.persistence = true});
   // The same after a reopening: the shards load their states from the checkpoint and the log.
   store.reset();
   store = OpenOrDie(map, dir.path());

@@ -181,6 +181,7 @@ void Shard::StoreModel(uint32_t d, const model::CompactStateModel& m) {
   spectra_.Store(d, m.spectrum());
   // A restored record past the limit is widened again from its float body (see wide_bodies.h).
   if (spectra_.header(d).n >= widen_at_) wide_.Widen(d, spectra_.body(d));
+  BeforeModelChange(d);
   if (m.has_published()) {
     models_.Set(d, m.published());
   } else {
@@ -593,6 +594,16 @@ void Shard::PredictBoxConstant(const CellBox& box, const model::PhasorTable& tab
       });
 }
 
+std::shared_ptr<const BrickModels> Shard::RegionModels() const {
+  base::MutexLock lock(&region_models_mutex_);
+  if (region_models_ == nullptr || region_models_->generation() != models_generation_) {
+    if (publishing_) return nullptr;
+    // Under the shared lock: no writer changes images_ or models_ while the copy is made.
+    region_models_ = std::make_shared<const BrickModels>(images_, models_, models_generation_);
+  }
+  return region_models_;
+}
+
 // PredictRegion's hot path keeps its own loop over the bricks' images (storage/brick_region.h),
 // not PredictBoxConstant's walk over handles (ForEachBoxCell): a cell's handle read and turned into
 // p was most of a 1M-cell region's time.
@@ -621,6 +632,11 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   static_assert(BrickImage::kNoHandle == kNone && BrickImage::kNeverChanged == kStaticHandle,
                 "a brick's image is kept from the shard's handles");
   const BoxBricks box_bricks(box, bs);
+  // The models of each brick's cells in one run, when they may be used: they hold each state at its
+  // own order, without persistence.
+  const std::shared_ptr<const BrickModels> brick_models =
+      options.order >= 0 || (options.persistence && settings_.persistence) ? nullptr : RegionModels();
+  std::array<T, 512> copied_values;
   walk.PrefetchImage(0);
   for (size_t b = 0; b < walk.bricks.size(); ++b) {
     walk.PrefetchImage(b + 1);
@@ -662,14 +678,47 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
         other_cells[m++] = at;
       }
     };
-    if (row_cells == bs[0] && hi[1] - lo[1] == bs[1] && hi[2] - lo[2] == bs[2]) {  // the whole brick
+    const bool whole = row_cells == bs[0] && hi[1] - lo[1] == bs[1] && hi[2] - lo[2] == bs[2];
+    const auto in_box = [&](uint32_t cell) {
+      const uint32_t x = layout_->X(cell), y = layout_->Y(cell), z = layout_->Z(cell);
+      return x >= lo[0] && x < hi[0] && y >= lo[1] && y < hi[1] && z >= lo[2] && z < hi[2];
+    };
+    // The cells the brick's copied models cover: their records through the kernel as one run, the
+    // values then scattered; the covered cells without a model yet gathered as below.
+    std::span<const BrickImage::DynamicCell> uncovered = image.dynamic();
+    const size_t index = &image - images_.data();
+    if (brick_models != nullptr && index < brick_models->size()) {
+      const BrickModels::Brick& copied = brick_models->brick(index);
+      if constexpr (std::is_same_v<T, uint8_t>) {
+        model::PredictColumnsU8(brick_models->models(), copied.first, copied.count, copied.terms, table,
+                                copied_values.data());
+      } else {
+        model::PredictColumns(brick_models->models(), copied.first, copied.count, copied.terms, table,
+                              copied_values.data());
+      }
+      // (The count in a local: a store through T* = uint8_t* could change it, for all the compiler knows.)
+      const uint16_t* cells = brick_models->cells() + copied.first;
+      const uint32_t count = copied.count;
+      if (whole) {
+        T* const first_cell = out + origin;
+        for (uint32_t i = 0; i < count; ++i) first_cell[offset[cells[i]]] = copied_values[i];
+      } else {
+        for (uint32_t i = 0; i < count; ++i) {
+          if (in_box(cells[i])) out[origin + offset[cells[i]]] = copied_values[i];
+        }
+      }
+      const BrickImage::DynamicCell* others = brick_models->others() + copied.others_first;
+      for (uint32_t i = 0; i < copied.others_count; ++i) {
+        if (whole || in_box(others[i].cell)) gather(others[i].handle, out + (origin + offset[others[i].cell]));
+      }
+      uncovered = uncovered.subspan(copied.covered);
+    }
+    if (whole) {
       T* const first_cell = out + origin;
-      for (const BrickImage::DynamicCell& cell : image.dynamic()) gather(cell.handle, first_cell + offset[cell.cell]);
+      for (const BrickImage::DynamicCell& cell : uncovered) gather(cell.handle, first_cell + offset[cell.cell]);
     } else {
-      for (const BrickImage::DynamicCell& cell : image.dynamic()) {
-        const uint32_t x = layout_->X(cell.cell), y = layout_->Y(cell.cell), z = layout_->Z(cell.cell);
-        if (x < lo[0] || x >= hi[0] || y < lo[1] || y >= hi[1] || z < lo[2] || z >= hi[2]) continue;
-        gather(cell.handle, out + (origin + offset[cell.cell]));
+      for (const BrickImage::DynamicCell& cell : uncovered) {
+        if (in_box(cell.cell)) gather(cell.handle, out + (origin + offset[cell.cell]));
       }
     }
     for (size_t i = 0; i < m; ++i) *other_cells[i] = CellValue<T>(PredictHandle(others[i], table, options));
@@ -755,6 +804,10 @@ ShardStats Shard::Stats() const {
                        slots_.capacity() * sizeof(Slot) +
                        brick_data_.capacity() * sizeof(Brick);
   for (const BrickImage& image : images_) stats.memory_bytes += image.memory_bytes();
+  {
+    base::MutexLock region_lock(&region_models_mutex_);
+    if (region_models_ != nullptr) stats.memory_bytes += region_models_->memory_bytes();
+  }
   if (auto used = env_->UsedBytes(); used.ok()) stats.disk_bytes = *used;
   return stats;
 }
@@ -949,6 +1002,7 @@ absl::Status Shard::Load() {
           }
           auto decoded = model::DecodePublishedModel(value, settings_.periods.size(), settings_.max_order);
           if (!decoded.ok()) return decoded.status();
+          BeforeModelChange(slots_[slot].dynamic);
           models_.Set(slots_[slot].dynamic, *decoded);
           return absl::OkStatus();
         });

@@ -28,6 +28,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <cstdint>
@@ -43,6 +44,7 @@
 #include "absl/status/statusor.h"
 #include "base/mutex.h"
 #include "storage/batch.h"
+#include "storage/brick_models.h"
 #include "storage/brick_region.h"
 #include "storage/dedup_table.h"
 #include "storage/lmdb/lmdb_env.h"
@@ -338,6 +340,22 @@ class Shard {
   model::WideBodies wide_ ABSL_GUARDED_BY(mutex_);
   const uint32_t widen_at_;
   model::CompactModels models_ ABSL_GUARDED_BY(mutex_);
+  // Counts the changes to records of models_ that were published (a publication, a restore): a
+  // BrickModels copy made at another count is out of date. New records and first publications do
+  // not count: the copy answers the cells it did not copy from models_ itself.
+  uint64_t models_generation_ ABSL_GUARDED_BY(mutex_) = 0;
+  // Bumps models_generation_ if record d is published (before the caller changes it).
+  void BeforeModelChange(uint32_t d) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_) {
+    if (models_.published(d)) ++models_generation_;
+  }
+  // The region's copy of the models brick by brick, made when first asked for after a change (not
+  // while a publication is under way, which would make it out of date again at each slice); null
+  // when there is none to use (a generic map, or an out-of-date copy during a publication).
+  std::shared_ptr<const BrickModels> RegionModels() const ABSL_SHARED_LOCKS_REQUIRED(mutex_)
+      ABSL_LOCKS_EXCLUDED(region_models_mutex_);
+  mutable base::Mutex region_models_mutex_ ABSL_ACQUIRED_AFTER(mutex_);
+  mutable std::shared_ptr<const BrickModels> region_models_ ABSL_GUARDED_BY(region_models_mutex_);
+  std::atomic<bool> publishing_{false};  // between BeginPublication and the end of its last slice
   model::OrderErrorTable errors_ ABSL_GUARDED_BY(mutex_);
   std::vector<model::Persistence> persistence_ ABSL_GUARDED_BY(mutex_);
   std::vector<model::LosslessHistory> lossless_histories_ ABSL_GUARDED_BY(mutex_);

@@ -22,6 +22,7 @@ constexpr size_t kStatesPerLock = 1024;
 
 void Shard::PublishState(uint32_t d, bool history_updated) {
   spectra_.Load(d, publish_scratch_);
+  BeforeModelChange(d);
   publisher_.Publish(publish_scratch_, errors_.BestOrder(d, settings_.order_rule), models_, d);
   if (settings_.error_half_life == 0) errors_.Reset(d);  // "only since the last update"
   if (lossless_ && !history_updated) (void)lossless_histories_[d].Update(settings_.max_order);
@@ -48,6 +49,7 @@ size_t Shard::BeginPublication() {
       publication_list_.push_back(d);
     }
   }
+  publishing_ = !publication_list_.empty();
   return publication_list_.size();
 }
 
@@ -75,7 +77,9 @@ bool Shard::ContinuePublication(std::chrono::nanoseconds budget) {
     }
     if (std::chrono::steady_clock::now() >= deadline) break;
   }
-  return publication_cursor_ == publication_list_.size();
+  const bool done = publication_cursor_ == publication_list_.size();
+  if (done) publishing_ = false;
+  return done;
 }
 
 size_t Shard::PublishAll(const std::function<void(uint64_t)>& progress) {

@@ -13,6 +13,7 @@
 #include <span>
 
 #include "storage/model/kernels/compact_models.h"
+#include "storage/model/kernels/model_columns.h"
 #include "storage/model/phasor.h"
 
 namespace fremen::model {
@@ -37,6 +38,16 @@ void PredictRegionU8(const CompactModels& models, size_t first, size_t count, co
 // REQUIRES: phasors of the models' Ω; every records[i] < models.size().
 void PredictRecords(const CompactModels& models, std::span<const uint32_t> records, const PhasorTable& phasors,
                     int order, float* out);
+
+// out[i] = p(t) of model first + i of `columns` at its own order, clamped to [0, 1]: bit for bit what
+// PredictRecords gives for the same records at order -1. `terms`: the components computed for each
+// model, at least the highest own order among them (the zeros past a model's own order add nothing).
+// REQUIRES: phasors of the models' Ω; first + count <= columns.size(); terms <= columns.max_order().
+void PredictColumns(const ModelColumns& columns, size_t first, size_t count, int terms, const PhasorTable& phasors,
+                    float* out);
+// The same, quantised (QuantizeProbability).
+void PredictColumnsU8(const ModelColumns& columns, size_t first, size_t count, int terms,
+                      const PhasorTable& phasors, uint8_t* out);
 
 // Every record of `models`.
 inline void PredictRegion(const CompactModels& models, const PhasorTable& phasors, int order, float* out) {
