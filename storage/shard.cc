@@ -616,8 +616,9 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   const BoxWalk walk = WalkOf(box);
   const std::array<uint32_t, 3> bs = walk.brick_size;
   // The cells whose state has a published model — nearly all dynamic ones, on a map in use — go
-  // through the region kernel together, a brick at a time, their records prefetched as they are
-  // gathered; the others are answered one by one. They are told apart by the published bits kept
+  // through the region kernel together, a brick at a time: from the brick's copy of them
+  // (BrickModels, when it covers them), else their records prefetched as they are gathered; the
+  // others are answered one by one. They are told apart by the published bits kept
   // beside the records (CompactModels::published), which read no record (a miss per dynamic cell,
   // one after another, was most of a 1M-cell region's samples when the check read the record's
   // header).

@@ -17,12 +17,14 @@
 #include <algorithm>
 #include <cstdio>
 #include <iterator>
+#include <memory>
 #include <random>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "storage/model/kernels/compact_models.h"
+#include "storage/model/kernels/model_columns.h"
 #include "storage/model/kernels/order_error_table.h"
 #include "storage/model/persistence.h"
 #include "storage/model/kernels/publication.h"
@@ -282,6 +284,35 @@ void BM_PredictListed(benchmark::State& state) {
                  (shuffled ? ", shuffled in bricks" : ", in order"));
 }
 BENCHMARK(BM_PredictListed)->ArgsProduct({{2, 5, -1}, {0, 1}})->Unit(benchmark::kMicrosecond);
+
+// The form a region reads a shard's published models in since they are copied brick by brick
+// (storage/brick_models.h): the same models as columns at their own orders, predicted as bytes in
+// runs of range(0) models (a brick's dynamic cells: 60 in fremen_query_load's map), each run at its
+// highest own order; range(1) models (all of Models(), 1M, as BM_PredictU8/-1 and
+// BM_PredictListed/-1/*, or 2^17, about fremen_query_load's box: 7 MB, which the cache holds).
+void BM_PredictColumnsU8(benchmark::State& state) {
+  const size_t run = static_cast<size_t>(state.range(0)), count = static_cast<size_t>(state.range(1));
+  const auto columns = std::make_unique<ModelColumns>(kL);
+  columns->Resize(count);
+  for (size_t i = 0; i < count; ++i) columns->SetZero(i, Models(), i);
+  std::vector<int> terms;
+  for (size_t first = 0; first < columns->size(); first += run) {
+    int highest = 0;
+    for (size_t i = first; i < std::min(columns->size(), first + run); ++i) {
+      highest = std::max<int>(highest, columns->order()[i]);
+    }
+    terms.push_back(highest);
+  }
+  RunPredictions<uint8_t>(state, [&](const CompactModels&, const PhasorTable& p, int, uint8_t* out) {
+    for (size_t first = 0, r = 0; first < columns->size(); first += run, ++r) {
+      PredictColumnsU8(*columns, first, std::min(run, columns->size() - first), terms[r], p, out + first);
+    }
+  });
+  // RunPredictions counts Models().size() a call.
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * count));
+  state.SetLabel("own orders, mixed 0..5, runs of " + std::to_string(run) + ", " + std::to_string(count) + " models");
+}
+BENCHMARK(BM_PredictColumnsU8)->ArgsProduct({{60, 512}, {1 << 17, 1 << 20}})->Unit(benchmark::kMicrosecond);
 
 // Order choice + top-L publication of kScanCells states (errors choose orders 0..5 at random).
 void BM_Publish(benchmark::State& state) {

@@ -4,9 +4,9 @@
 // CompactModels keeps a model's fields together in one record, which suits reading one state; a
 // run of many states through the same loop reads better as columns: alpha0 of every model in one
 // array, then for each component j the period indices, a and b of every model in three. The loop
-// over a run then goes component by component over consecutive models, which vectorises (the
-// cosines and sines of the period indices fetched with gathers on AVX2), where the per-record loop
-// summed a model's few components one after another.
+// over a run then goes component by component over consecutive models, whose sums are independent
+// of each other, where the per-record loop summed a model's few components one after another, and
+// read each record's header first to find the run's highest order.
 //
 // A model's components past its own order are stored as zero (k = 0, a = b = 0): they add exactly
 // zero, so a run is computed at its highest own order without a per-model mask, and each model's

@@ -6,13 +6,6 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
-// AVX2 gathers for PredictColumns, chosen at run time (x86-64 with GCC or Clang).
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#define FREMEN_COLUMNS_AVX2 1
-#else
-#define FREMEN_COLUMNS_AVX2 0
-#endif
 
 namespace fremen::model {
 namespace {
@@ -181,36 +174,16 @@ void Predict(const CompactModels& models, Records records, size_t count, const P
   Dispatch<false>(models, records, count, phasors, std::min(order, models.max_order()), out);
 }
 
-// raw[i] += a[i]·cos ω_k[i] t − b[i]·sin ω_k[i] t, i < n: one component of a run of models.
+// raw[i] += a[i]·cos ω_k[i] t − b[i]·sin ω_k[i] t, i < n: one component of a run of models. (An AVX2
+// version with two gathers per eight models was slower on this machine's AMD EPYC: 178-235M
+// models/s against 250-295M, fremen_model_bench's BM_PredictColumnsU8 with 2^17 models;
+// docs/performance.md, "A brick's models in one run".)
 void AddComponent(const uint16_t* k, const float* a, const float* b, size_t n, const float* cos_t,
                   const float* sin_t, float* raw) {
   for (size_t i = 0; i < n; ++i) raw[i] += a[i] * cos_t[k[i]] - b[i] * sin_t[k[i]];
 }
 
-#if FREMEN_COLUMNS_AVX2
-// The same eight models at a time, the cosines and sines fetched by two gathers (g++ 12 does not
-// emit gathers for AddComponent's loop: it builds each vector from eight loads, ~7 instructions a
-// model). Multiplications, subtraction and addition as separate IEEE operations, no FMA: each
-// element is AddComponent's to the bit.
-[[gnu::target("avx2")]] void AddComponentAvx2(const uint16_t* k, const float* a, const float* b, size_t n,
-                                              const float* cos_t, const float* sin_t, float* raw) {
-  size_t i = 0;
-  for (; i + 8 <= n; i += 8) {
-    const __m256i index = _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(k + i)));
-    const __m256 cos_k = _mm256_i32gather_ps(cos_t, index, sizeof(float));
-    const __m256 sin_k = _mm256_i32gather_ps(sin_t, index, sizeof(float));
-    const __m256 term =
-        _mm256_sub_ps(_mm256_mul_ps(_mm256_loadu_ps(a + i), cos_k), _mm256_mul_ps(_mm256_loadu_ps(b + i), sin_k));
-    _mm256_storeu_ps(raw + i, _mm256_add_ps(_mm256_loadu_ps(raw + i), term));
-  }
-  AddComponent(k + i, a + i, b + i, n - i, cos_t, sin_t, raw + i);
-}
-
-const bool kHasAvx2 = __builtin_cpu_supports("avx2");
-#endif
-
-// PredictColumns: a block of models at a time, component by component over the block, so that the
-// loop over models vectorises. Each model's sum is alpha0, then its components added in order, as
+// PredictColumns: a block of models at a time, component by component over the block. Each model's sum is alpha0, then its components added in order, as
 // SumBlock adds them.
 template <typename Out>
 void ColumnsRange(const ModelColumns& columns, size_t first, size_t count, int terms, const float* cos_t,
@@ -218,14 +191,18 @@ void ColumnsRange(const ModelColumns& columns, size_t first, size_t count, int t
   float raw[kBlock];
   for (size_t start = 0; start < count; start += kBlock) {
     const size_t n = std::min(kBlock, count - start), at = first + start;
-    std::copy_n(columns.alpha0() + at, n, raw);
-    for (int j = 0; j < terms; ++j) {
-#if FREMEN_COLUMNS_AVX2
-      if (kHasAvx2) {
-        AddComponentAvx2(columns.k(j) + at, columns.a(j) + at, columns.b(j) + at, n, cos_t, sin_t, raw);
-        continue;
-      }
-#endif
+    // alpha0 + the first component in one pass, which is p = alpha0; p += term: the copy of alpha0
+    // alone was a `rep movsq`, whose start-up cost a brick's run of ~60 models does not amortise
+    // (a fifth of the kernel's samples).
+    const float* alpha0 = columns.alpha0() + at;
+    if (terms == 0) {
+      for (size_t i = 0; i < n; ++i) raw[i] = alpha0[i];
+    } else {
+      const uint16_t* k = columns.k(0) + at;
+      const float *a = columns.a(0) + at, *b = columns.b(0) + at;
+      for (size_t i = 0; i < n; ++i) raw[i] = alpha0[i] + (a[i] * cos_t[k[i]] - b[i] * sin_t[k[i]]);
+    }
+    for (int j = 1; j < terms; ++j) {
       AddComponent(columns.k(j) + at, columns.a(j) + at, columns.b(j) + at, n, cos_t, sin_t, raw);
     }
     Emit(raw, n, out + start);
