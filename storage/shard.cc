@@ -684,8 +684,8 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
       const uint32_t x = layout_->X(cell), y = layout_->Y(cell), z = layout_->Z(cell);
       return x >= lo[0] && x < hi[0] && y >= lo[1] && y < hi[1] && z >= lo[2] && z < hi[2];
     };
-    // The cells the brick's copied models cover: their records through the kernel as one run, the
-    // values then scattered; the covered cells without a model yet gathered as below.
+    // The cells the brick's copied models cover: their models through the kernel as one run, the
+    // values then scattered; the covered cells that had no model gathered as below.
     std::span<const BrickImage::DynamicCell> uncovered = image.dynamic();
     const size_t index = &image - images_.data();
     if (brick_models != nullptr && index < brick_models->size()) {
