@@ -104,6 +104,28 @@ class FremendProcess:
                 self.kill()
         return self.process.returncode
 
+    def pause(self):
+        """SIGSTOP, then waits until every thread of the daemon has stopped: the signal only marks
+        the process, and a thread running on another core goes on until it is interrupted (long
+        enough to read and log a batch sent just after kill() returned)."""
+        os.kill(self.process.pid, signal.SIGSTOP)
+        deadline = time.monotonic() + STOP_TIMEOUT
+        task_dir = "/proc/%d/task" % self.process.pid
+        while True:
+            states = []
+            for task in os.listdir(task_dir):
+                try:
+                    with open(os.path.join(task_dir, task, "stat")) as stat:
+                        # The state follows the command name in parentheses, which may hold spaces.
+                        states.append(stat.read().rsplit(")", 1)[1].split()[0])
+                except FileNotFoundError:  # a thread that has just exited
+                    pass
+            if states and all(state in ("T", "t") for state in states):
+                return
+            if time.monotonic() > deadline:
+                raise AssertionError("fremend's threads did not all stop: states %s" % states)
+            time.sleep(POLL_INTERVAL)
+
     def kill(self):
         if self.process.poll() is None:
             self.process.kill()

@@ -4,8 +4,6 @@ duplicates, a writer that lost its count, many batches in flight, a stream that 
 message the daemon cannot parse."""
 
 import math
-import os
-import signal
 import unittest
 
 import grpc
@@ -245,7 +243,7 @@ class IngestTest(DaemonTestCase):
             session.send(T + i, [1], names=["a"])
         self.assertEqual(len(session.wait()), 5)
         # A stopped daemon answers nothing: the next batches stay unanswered, until it dies.
-        os.kill(self.daemon.process.pid, signal.SIGSTOP)
+        self.daemon.pause()
         for i in range(5, 8):
             session.send(T + i, [1], names=["a"])
         self.daemon.kill()

@@ -6,8 +6,6 @@ unanswered batches kept for a manual resend), as do calls that are not retried. 
 injects the one fault a real daemon cannot cause: a stream whose call ended while gRPC's response
 iterator waits for ever; the session abandons it and resumes (or fails, without resume)."""
 
-import os
-import signal
 import threading
 import time
 import unittest
@@ -114,7 +112,7 @@ class ReconnectTest(DaemonTestCase):
         for i in range(5):
             session.send(T + i, [1], names=["a"])
         self.assertEqual(len(session.wait()), 5)
-        os.kill(self.daemon.process.pid, signal.SIGSTOP)  # answers nothing from now on
+        self.daemon.pause()  # answers nothing from now on
         for i in range(5, 8):
             session.send(T + i, [1], names=["a"])
         self.daemon.kill()
