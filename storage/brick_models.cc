@@ -35,8 +35,8 @@ BrickModels::BrickModels(std::span<const BrickImage> images, const model::Compac
 }
 
 size_t BrickModels::memory_bytes() const {
-  return sizeof(*this) + bricks_.capacity() * sizeof(Brick) + models_.memory_bytes() + cells_.capacity() * sizeof(uint16_t) +
-         others_.capacity() * sizeof(BrickImage::DynamicCell);
+  return sizeof(*this) + bricks_.capacity() * sizeof(Brick) + models_.memory_bytes() +
+         cells_.capacity() * sizeof(uint16_t) + others_.capacity() * sizeof(BrickImage::DynamicCell);
 }
 
 }  // namespace fremen::storage

@@ -176,15 +176,15 @@ void Predict(const CompactModels& models, Records records, size_t count, const P
 
 // raw[i] += a[i]·cos ω_k[i] t − b[i]·sin ω_k[i] t, i < n: one component of a run of models. (An AVX2
 // version with two gathers per eight models was slower on this machine's AMD EPYC: 178-235M
-// models/s against 250-295M, fremen_model_bench's BM_PredictColumnsU8 with 2^17 models;
+// models/s against 245-295M, fremen_model_bench's BM_PredictColumnsU8 with 2^17 models;
 // docs/performance.md, "A brick's models in one run".)
 void AddComponent(const uint16_t* k, const float* a, const float* b, size_t n, const float* cos_t,
                   const float* sin_t, float* raw) {
   for (size_t i = 0; i < n; ++i) raw[i] += a[i] * cos_t[k[i]] - b[i] * sin_t[k[i]];
 }
 
-// PredictColumns: a block of models at a time, component by component over the block. Each model's sum is alpha0, then its components added in order, as
-// SumBlock adds them.
+// PredictColumns: a block of models at a time, component by component over the block. Each model's
+// sum is alpha0, then its components added in order, as SumBlock adds them.
 template <typename Out>
 void ColumnsRange(const ModelColumns& columns, size_t first, size_t count, int terms, const float* cos_t,
                   const float* sin_t, Out* out) {
