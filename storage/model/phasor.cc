@@ -1,5 +1,6 @@
 #include "storage/model/phasor.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -29,8 +30,12 @@ void PhasorTable::Reset(const PeriodSet& periods, double t) {
   const size_t k_count = periods.size();
   cos_.resize(k_count);
   sin_.resize(k_count);
-  cos_f_.resize(k_count);
-  sin_f_.resize(k_count);
+  // Zero-padded to whole vectors of kFloatLanes (see cos_f()).
+  const size_t padded = (k_count + kFloatLanes - 1) / kFloatLanes * kFloatLanes;
+  cos_f_.resize(padded);
+  sin_f_.resize(padded);
+  std::fill(cos_f_.begin() + k_count, cos_f_.end(), 0.0f);
+  std::fill(sin_f_.begin() + k_count, sin_f_.end(), 0.0f);
   if (periods.harmonic()) {
     // z^(k+1) for k < K, z = e^{jω_1 t}: four interleaved chains z^(k+1) = z^(k−3)·z^4, since one
     // chain of K dependent multiplications waits on each one's latency (it measured 20 % of a

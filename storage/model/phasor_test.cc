@@ -86,5 +86,21 @@ TEST(PhasorTableTest, ResetEqualsAFreshTable) {
   }
 }
 
+// The float tables end with zeros up to whole vectors of kFloatLanes, also after a Reset to a smaller
+// Ω (whose padding covers entries the larger one used).
+TEST(PhasorTableTest, FloatTablesArePaddedWithZerosToWholeVectors) {
+  const PeriodSet larger = *PeriodSet::Harmonics(604800, 31);
+  const PeriodSet smaller = *PeriodSet::Harmonics(604800, 19);
+  PhasorTable table(larger, 1.7e9);
+  EXPECT_NE(table.cos_f()[30], 0.0f);
+  table.Reset(smaller, 1.7e9 + 60.0);
+  ASSERT_EQ(table.size(), 19u);
+  for (size_t k = 19; k < 24; ++k) {
+    EXPECT_EQ(table.cos_f()[k], 0.0f) << k;
+    EXPECT_EQ(table.sin_f()[k], 0.0f) << k;
+  }
+  EXPECT_NE(table.cos_f()[18], 0.0f);
+}
+
 }  // namespace
 }  // namespace fremen::model

@@ -7,13 +7,22 @@ namespace fremen::model {
 
 ModelColumns::ModelColumns(int max_order) : k_(max_order), a_(max_order), b_(max_order) {}
 
+namespace {
+// `column` holds n models and kReadablePast zeros after them (also after a shrink).
+template <typename T>
+void ResizeColumn(std::vector<T>& column, size_t n) {
+  column.resize(n + ModelColumns::kReadablePast);
+  std::fill(column.begin() + static_cast<std::ptrdiff_t>(n), column.end(), T{0});
+}
+}  // namespace
+
 void ModelColumns::Resize(size_t n) {
-  alpha0_.resize(n);
   order_.resize(n);
+  ResizeColumn(alpha0_, n);
   for (int j = 0; j < max_order(); ++j) {
-    k_[j].resize(n);
-    a_[j].resize(n);
-    b_[j].resize(n);
+    ResizeColumn(k_[j], n);
+    ResizeColumn(a_[j], n);
+    ResizeColumn(b_[j], n);
   }
 }
 

@@ -28,8 +28,13 @@ class ModelColumns {
   // REQUIRES: 0 <= max_order <= kMaxMaxOrder.
   explicit ModelColumns(int max_order);
 
+  // Every column may be read this many entries past size(): a vector kernel loads whole vectors of
+  // eight at a run's end and drops the lanes past it, with no scalar tail (which was a fifth of
+  // PredictColumns' time in runs of 60). After the last model they are zeros: period index 0.
+  static constexpr size_t kReadablePast = 7;
+
   int max_order() const { return static_cast<int>(k_.size()); }
-  size_t size() const { return alpha0_.size(); }
+  size_t size() const { return order_.size(); }
   // Grows with zero models (alpha0 0, no components) or shrinks to n models.
   void Resize(size_t n);
   // Model i becomes record r of `models` at its own order.
@@ -38,7 +43,7 @@ class ModelColumns {
 
   const float* alpha0() const { return alpha0_.data(); }
   const uint8_t* order() const { return order_.data(); }
-  // Component j (0-based) of every model. REQUIRES: j < max_order().
+  // Component j (0-based) of every model, kReadablePast entries more. REQUIRES: j < max_order().
   const uint16_t* k(int j) const { return k_[j].data(); }
   const float* a(int j) const { return a_[j].data(); }
   const float* b(int j) const { return b_[j].data(); }

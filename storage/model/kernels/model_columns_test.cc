@@ -1,7 +1,9 @@
 // ModelColumns and PredictColumns: the columns hold each published model at its own order, and a
 // run of them predicts bit for bit what the records give at each state's own order (PredictRecords
-// at order -1), as floats and as bytes, on the AVX2 path and the scalar one alike (runs whose
-// lengths are not multiples of eight, and which start anywhere).
+// at order -1), as floats and as bytes, on the AVX2 path (Ω of up to 8, 16, 24 and 32 periods: one
+// to four vectors of the table) and the scalar one (more periods, or a machine without AVX2) alike,
+// for runs whose lengths are not multiples of eight, which start anywhere and end anywhere,
+// including at the columns' end.
 #include "storage/model/kernels/model_columns.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +11,8 @@
 #include <algorithm>
 #include <cstring>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "storage/model/kernels/kernel_test_data.h"
@@ -22,12 +26,12 @@ constexpr int kL = 5;
 // Published models of random cells at every order 0..L (some with more components than their
 // order), appended to the columns in a shuffled order.
 struct Fixture {
-  PeriodSet periods = PeriodSet::Default();
+  PeriodSet periods;
   CompactModels models{kL};
   std::vector<uint32_t> records;  // records[i]: the record behind column model i
   ModelColumns columns{kL};
 
-  explicit Fixture(size_t count) {
+  explicit Fixture(size_t count, PeriodSet omega = PeriodSet::Default()) : periods(std::move(omega)) {
     std::mt19937_64 rng(5);
     const auto spectra = testing::RandomCellSpectra(periods, count, 9);
     models.Resize(count);
@@ -66,10 +70,40 @@ TEST(ModelColumnsTest, HoldEachModelAtItsOwnOrder) {
   EXPECT_GT(f.columns.memory_bytes(), f.columns.size() * (sizeof(float) + kL * 10));
 }
 
-// Runs of every length up to 40 at several starts, then one longer than a block (256), at the
-// highest own order of the run and at L: each value equals the records' own-order prediction.
-TEST(ModelColumnsTest, PredictColumnsEqualsPredictRecordsAtOwnOrders) {
-  const Fixture f(700);
+// A shrink leaves no model behind: the columns grow again with zero models, and the entries a vector
+// kernel reads past the end are zeros.
+TEST(ModelColumnsTest, ShrinkThenGrowGivesZeroModels) {
+  Fixture f(40);
+  f.columns.Resize(10);
+  f.columns.Resize(30);
+  ASSERT_EQ(f.columns.size(), 30u);
+  for (size_t i = 10; i < 30 + ModelColumns::kReadablePast; ++i) {
+    if (i < 30) {
+      EXPECT_EQ(f.columns.order()[i], 0) << i;
+    }
+    EXPECT_EQ(f.columns.alpha0()[i], 0.0f) << i;
+    for (int j = 0; j < kL; ++j) {
+      EXPECT_EQ(f.columns.k(j)[i], 0) << i << " " << j;
+      EXPECT_EQ(f.columns.a(j)[i], 0.0f) << i << " " << j;
+      EXPECT_EQ(f.columns.b(j)[i], 0.0f) << i << " " << j;
+    }
+  }
+  EXPECT_EQ(f.columns.alpha0()[9], f.models.header(f.records[9]).alpha0);  // the kept ones are kept
+}
+
+// Runs of every length up to 40 at several starts, runs that end at the columns' last model, then one
+// longer than a block (256), at the highest own order of the run and at L: each value equals the
+// records' own-order prediction. For Ω of several sizes, which take the AVX2 path with one to four
+// vectors of the table, or the scalar one.
+class PredictColumnsTest : public ::testing::TestWithParam<int> {};
+
+TEST_P(PredictColumnsTest, EqualsPredictRecordsAtOwnOrders) {
+  const int period_count = GetParam();
+  const Fixture f(700, *PeriodSet::Harmonics(kWeekSeconds, period_count));
+  if (period_count > 32) {
+    EXPECT_FALSE(PredictColumnsPermutes(f.periods.size()));
+  }
+  ::testing::Test::RecordProperty("permutes", PredictColumnsPermutes(f.periods.size()) ? "yes" : "no");
   for (const double t : {1.7e9, 1.7e9 + 12345.6, 1.7e9 + 86400.0 * 9.3}) {
     const PhasorTable table(f.periods, t);
     std::vector<float> expected(f.records.size());
@@ -93,11 +127,16 @@ TEST(ModelColumnsTest, PredictColumnsEqualsPredictRecordsAtOwnOrders) {
       }
     };
     for (size_t count = 0; count <= 40; ++count) {
-      for (const size_t first : {size_t{0}, size_t{3}, size_t{101}}) check(first, count);
+      for (const size_t first : {size_t{0}, size_t{3}, size_t{101}, f.columns.size() - count}) check(first, count);
     }
     check(13, 600);
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(PeriodCounts, PredictColumnsTest, ::testing::Values(5, 8, 12, 16, 24, 32, 33, 40),
+                         [](const ::testing::TestParamInfo<int>& info) {
+                           return "Omega" + std::to_string(info.param);
+                         });
 
 }  // namespace
 }  // namespace fremen::model

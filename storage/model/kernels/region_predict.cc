@@ -6,6 +6,13 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+// PredictColumns' AVX2 path, chosen at run time (x86-64 with GCC or Clang).
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define FREMEN_COLUMNS_PERMUTE 1
+#else
+#define FREMEN_COLUMNS_PERMUTE 0
+#endif
 
 namespace fremen::model {
 namespace {
@@ -174,37 +181,136 @@ void Predict(const CompactModels& models, Records records, size_t count, const P
   Dispatch<false>(models, records, count, phasors, std::min(order, models.max_order()), out);
 }
 
-// raw[i] += a[i]·cos ω_k[i] t − b[i]·sin ω_k[i] t, i < n: one component of a run of models. (An AVX2
-// version with two gathers per eight models was slower on this machine's AMD EPYC: 178-235M
-// models/s against 245-295M, fremen_model_bench's BM_PredictColumnsU8 with 2^17 models;
-// docs/performance.md, "A brick's models in one run".)
+// raw[i] += a[i]·cos ω_k[i] t − b[i]·sin ω_k[i] t, i < n: one component of a run of models.
 void AddComponent(const uint16_t* k, const float* a, const float* b, size_t n, const float* cos_t,
                   const float* sin_t, float* raw) {
   for (size_t i = 0; i < n; ++i) raw[i] += a[i] * cos_t[k[i]] - b[i] * sin_t[k[i]];
 }
 
-// PredictColumns: a block of models at a time, component by component over the block. Each model's
-// sum is alpha0, then its components added in order, as SumBlock adds them.
+// raw[i] = the sum of model at + i's first `terms` components, i < n: alpha0, then each component
+// added in order, as SumBlock adds them.
+void SumColumns(const ModelColumns& columns, size_t at, size_t n, int terms, const float* cos_t, const float* sin_t,
+                float* raw) {
+  // alpha0 + the first component in one pass, which is p = alpha0; p += term: the copy of alpha0
+  // alone was a `rep movsq`, whose start-up cost a brick's run of ~60 models does not amortise
+  // (a fifth of the kernel's samples).
+  const float* alpha0 = columns.alpha0() + at;
+  if (terms == 0) {
+    for (size_t i = 0; i < n; ++i) raw[i] = alpha0[i];
+    return;
+  }
+  const uint16_t* k = columns.k(0) + at;
+  const float *a = columns.a(0) + at, *b = columns.b(0) + at;
+  for (size_t i = 0; i < n; ++i) raw[i] = alpha0[i] + (a[i] * cos_t[k[i]] - b[i] * sin_t[k[i]]);
+  for (int j = 1; j < terms; ++j) {
+    AddComponent(columns.k(j) + at, columns.a(j) + at, columns.b(j) + at, n, cos_t, sin_t, raw);
+  }
+}
+
+#if FREMEN_COLUMNS_PERMUTE
+// The same sums eight models at a time, with the cosines and sines of their periods looked up by
+// vector permutes: the float tables of Ω (at most kPermuteParts · 8 periods, zero-padded to whole
+// vectors: PhasorTable::cos_f) are held in registers, and vpermps picks each model's entry from a
+// vector of eight by the index's low three bits; blends on bits 3 and 4 pick the vector. That is 3
+// permutes and 2 blends a table for the default 24 periods. g++ 12 builds AddComponent's vectors
+// from eight scalar loads each, and AVX2's gathers were slower than those loads on this machine's
+// AMD EPYC (docs/performance.md, "A brick's models in one run"). Multiplications, subtraction and
+// additions as separate IEEE operations in SumColumns' order, no FMA: each sum is SumColumns' to
+// the bit (this file is compiled with -ffp-contract=off, so no build fuses them).
+constexpr int kPermuteParts = 4;
+
+// Entry idx of the table held as kParts vectors of eight (idx < 8 · kParts). `bit3`, `bit4`: idx
+// shifted so that its bit 3 and bit 4 are the sign bits, which blendv reads.
+template <int kParts>
+[[gnu::target("avx2"), gnu::always_inline]] inline __m256 LookUp(const __m256* table, __m256i idx, __m256 bit3,
+                                                                 __m256 bit4) {
+  const __m256 low = _mm256_permutevar8x32_ps(table[0], idx);
+  if constexpr (kParts == 1) return low;
+  const __m256 first16 = _mm256_blendv_ps(low, _mm256_permutevar8x32_ps(table[1], idx), bit3);
+  if constexpr (kParts == 2) return first16;
+  __m256 next16 = _mm256_permutevar8x32_ps(table[2], idx);
+  if constexpr (kParts == 4) next16 = _mm256_blendv_ps(next16, _mm256_permutevar8x32_ps(table[3], idx), bit3);
+  return _mm256_blendv_ps(first16, next16, bit4);
+}
+
+// Eight clamped probabilities as Emit writes them: floats, or bytes quantised as QuantizeProbability
+// does (p · 255 + 0.5 as two IEEE operations, then truncated).
+[[gnu::target("avx2"), gnu::always_inline]] inline void Store8(__m256 p, float* out) { _mm256_storeu_ps(out, p); }
+[[gnu::target("avx2"), gnu::always_inline]] inline void Store8(__m256 p, uint8_t* out) {
+  const __m256i q = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(p, _mm256_set1_ps(255.0f)), _mm256_set1_ps(0.5f)));
+  const __m128i words = _mm_packus_epi32(_mm256_castsi256_si128(q), _mm256_extracti128_si256(q, 1));
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(out), _mm_packus_epi16(words, words));
+}
+
+// PredictColumns on this path: each vector of eight summed, clamped (maxps and minps, as Clamp) and
+// written out. A run's last, partial vector reads past it (ModelColumns::kReadablePast) and keeps
+// only its first lanes.
+template <int kParts, typename Out>
+[[gnu::target("avx2")]] void PredictColumnsPermuted(const ModelColumns& columns, size_t at, size_t n, int terms,
+                                                    const float* cos_t, const float* sin_t, Out* out) {
+  __m256 cos_v[kParts], sin_v[kParts];
+  for (int part = 0; part < kParts; ++part) {
+    cos_v[part] = _mm256_loadu_ps(cos_t + 8 * part);
+    sin_v[part] = _mm256_loadu_ps(sin_t + 8 * part);
+  }
+  static_assert(ModelColumns::kReadablePast >= 7);
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+  for (size_t i = 0; i < n; i += 8) {
+    __m256 p = _mm256_loadu_ps(columns.alpha0() + at + i);
+    for (int j = 0; j < terms; ++j) {
+      const __m256i idx =
+          _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(columns.k(j) + at + i)));
+      const __m256 bit3 = _mm256_castsi256_ps(_mm256_slli_epi32(idx, 28));
+      const __m256 bit4 = _mm256_castsi256_ps(_mm256_slli_epi32(idx, 27));
+      const __m256 term = _mm256_sub_ps(_mm256_mul_ps(_mm256_loadu_ps(columns.a(j) + at + i),
+                                                      LookUp<kParts>(cos_v, idx, bit3, bit4)),
+                                        _mm256_mul_ps(_mm256_loadu_ps(columns.b(j) + at + i),
+                                                      LookUp<kParts>(sin_v, idx, bit3, bit4)));
+      p = _mm256_add_ps(p, term);
+    }
+    p = _mm256_min_ps(one, _mm256_max_ps(zero, p));
+    if (i + 8 <= n) {
+      Store8(p, out + i);
+    } else {
+      Out last[8];
+      Store8(p, last);
+      std::copy_n(last, n - i, out + i);
+    }
+  }
+}
+
+const bool kHasAvx2 = __builtin_cpu_supports("avx2");
+#endif
+
+bool Permutes(size_t periods) {
+#if FREMEN_COLUMNS_PERMUTE
+  return kHasAvx2 && periods <= 8 * kPermuteParts;
+#else
+  return false;
+#endif
+}
+
+// PredictColumns: by permutes where the machine and Ω allow; else a block of models at a time,
+// summed, then clamped (and quantised) together.
 template <typename Out>
-void ColumnsRange(const ModelColumns& columns, size_t first, size_t count, int terms, const float* cos_t,
-                  const float* sin_t, Out* out) {
+void ColumnsRange(const ModelColumns& columns, size_t first, size_t count, int terms, const PhasorTable& phasors,
+                  Out* out) {
+  const float *cos_t = phasors.cos_f(), *sin_t = phasors.sin_f();
+#if FREMEN_COLUMNS_PERMUTE
+  if (Permutes(phasors.size())) {
+    switch ((phasors.size() + 7) / 8) {
+      case 0:
+      case 1: return PredictColumnsPermuted<1>(columns, first, count, terms, cos_t, sin_t, out);
+      case 2: return PredictColumnsPermuted<2>(columns, first, count, terms, cos_t, sin_t, out);
+      case 3: return PredictColumnsPermuted<3>(columns, first, count, terms, cos_t, sin_t, out);
+      default: return PredictColumnsPermuted<4>(columns, first, count, terms, cos_t, sin_t, out);
+    }
+  }
+#endif
   float raw[kBlock];
   for (size_t start = 0; start < count; start += kBlock) {
-    const size_t n = std::min(kBlock, count - start), at = first + start;
-    // alpha0 + the first component in one pass, which is p = alpha0; p += term: the copy of alpha0
-    // alone was a `rep movsq`, whose start-up cost a brick's run of ~60 models does not amortise
-    // (a fifth of the kernel's samples).
-    const float* alpha0 = columns.alpha0() + at;
-    if (terms == 0) {
-      for (size_t i = 0; i < n; ++i) raw[i] = alpha0[i];
-    } else {
-      const uint16_t* k = columns.k(0) + at;
-      const float *a = columns.a(0) + at, *b = columns.b(0) + at;
-      for (size_t i = 0; i < n; ++i) raw[i] = alpha0[i] + (a[i] * cos_t[k[i]] - b[i] * sin_t[k[i]]);
-    }
-    for (int j = 1; j < terms; ++j) {
-      AddComponent(columns.k(j) + at, columns.a(j) + at, columns.b(j) + at, n, cos_t, sin_t, raw);
-    }
+    const size_t n = std::min(kBlock, count - start);
+    SumColumns(columns, first + start, n, terms, cos_t, sin_t, raw);
     Emit(raw, n, out + start);
   }
 }
@@ -213,13 +319,15 @@ void ColumnsRange(const ModelColumns& columns, size_t first, size_t count, int t
 
 void PredictColumns(const ModelColumns& columns, size_t first, size_t count, int terms, const PhasorTable& phasors,
                     float* out) {
-  ColumnsRange(columns, first, count, terms, phasors.cos_f(), phasors.sin_f(), out);
+  ColumnsRange(columns, first, count, terms, phasors, out);
 }
 
 void PredictColumnsU8(const ModelColumns& columns, size_t first, size_t count, int terms,
                       const PhasorTable& phasors, uint8_t* out) {
-  ColumnsRange(columns, first, count, terms, phasors.cos_f(), phasors.sin_f(), out);
+  ColumnsRange(columns, first, count, terms, phasors, out);
 }
+
+bool PredictColumnsPermutes(size_t periods) { return Permutes(periods); }
 
 void PredictRegion(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order,
                    float* out) {

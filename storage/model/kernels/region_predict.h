@@ -48,6 +48,10 @@ void PredictColumns(const ModelColumns& columns, size_t first, size_t count, int
 // The same, quantised (QuantizeProbability).
 void PredictColumnsU8(const ModelColumns& columns, size_t first, size_t count, int terms,
                       const PhasorTable& phasors, uint8_t* out);
+// Whether PredictColumns takes its AVX2 path, eight models at a time with the table of Ω's periods in
+// registers, for an Ω of `periods` periods on this machine (up to 32, with AVX2); else it is scalar.
+// For tests and logs: both give the same bits.
+bool PredictColumnsPermutes(size_t periods);
 
 // Every record of `models`.
 inline void PredictRegion(const CompactModels& models, const PhasorTable& phasors, int order, float* out) {
