@@ -289,9 +289,16 @@ BENCHMARK(BM_PredictListed)->ArgsProduct({{2, 5, -1}, {0, 1}})->Unit(benchmark::
 // (storage/brick_models.h): the same models as columns at their own orders, predicted as bytes in
 // runs of range(0) models (a brick's dynamic cells: 60 in fremen_query_load's map), each run at its
 // highest own order; range(1) models (all of Models(), 1M, as BM_PredictU8/-1 and
-// BM_PredictListed/-1/*, or 2^17, about fremen_query_load's box: 7 MB, which the cache holds).
+// BM_PredictListed/-1/*, or 2^17, about fremen_query_load's box: 7 MB, which the cache holds), on
+// path range(2) (ColumnsPath: 0 AVX-512, 1 AVX2, 2 scalar; skipped where the machine has not it).
 void BM_PredictColumnsU8(benchmark::State& state) {
   const size_t run = static_cast<size_t>(state.range(0)), count = static_cast<size_t>(state.range(1));
+  const auto path = static_cast<ColumnsPath>(state.range(2));
+  const char* const path_names[] = {"AVX-512", "AVX2", "scalar"};
+  if (!PredictColumnsCan(path, PeriodSet::Default().size())) {
+    state.SkipWithError((std::string(path_names[state.range(2)]) + ": not on this machine").c_str());
+    return;
+  }
   const auto columns = std::make_unique<ModelColumns>(kL);
   columns->Resize(count);
   for (size_t i = 0; i < count; ++i) columns->SetZero(i, Models(), i);
@@ -305,14 +312,17 @@ void BM_PredictColumnsU8(benchmark::State& state) {
   }
   RunPredictions<uint8_t>(state, [&](const CompactModels&, const PhasorTable& p, int, uint8_t* out) {
     for (size_t first = 0, r = 0; first < columns->size(); first += run, ++r) {
-      PredictColumnsU8(*columns, first, std::min(run, columns->size() - first), terms[r], p, out + first);
+      PredictColumnsOn(path, *columns, first, std::min(run, columns->size() - first), terms[r], p, out + first);
     }
   });
   // RunPredictions counts Models().size() a call.
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * count));
-  state.SetLabel("own orders, mixed 0..5, runs of " + std::to_string(run) + ", " + std::to_string(count) + " models");
+  state.SetLabel(std::string(path_names[state.range(2)]) + ", own orders, mixed 0..5, runs of " + std::to_string(run) +
+                 ", " + std::to_string(count) + " models");
 }
-BENCHMARK(BM_PredictColumnsU8)->ArgsProduct({{60, 512}, {1 << 17, 1 << 20}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PredictColumnsU8)
+    ->ArgsProduct({{60, 512}, {1 << 17, 1 << 20}, {0, 1, 2}})
+    ->Unit(benchmark::kMicrosecond);
 
 // Order choice + top-L publication of kScanCells states (errors choose orders 0..5 at random).
 void BM_Publish(benchmark::State& state) {

@@ -38,9 +38,9 @@ class PhasorTable {
   std::complex<double> conj_phasor(size_t k) const { return {cos_[k], -sin_[k]}; }
 
   // The same values as floats, for the vectorised kernels; zeros follow up to a multiple of
-  // kFloatLanes entries, so that a kernel may hold the table as whole vectors of eight
-  // (PredictColumns looks periods up with vector permutes).
-  static constexpr size_t kFloatLanes = 8;
+  // kFloatLanes entries, so that a kernel may hold the table as whole vectors of sixteen (AVX-512) or
+  // eight (PredictColumns looks periods up with vector permutes).
+  static constexpr size_t kFloatLanes = 16;
   const float* cos_f() const { return cos_f_.data(); }
   const float* sin_f() const { return sin_f_.data(); }
 

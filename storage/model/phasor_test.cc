@@ -95,7 +95,8 @@ TEST(PhasorTableTest, FloatTablesArePaddedWithZerosToWholeVectors) {
   EXPECT_NE(table.cos_f()[30], 0.0f);
   table.Reset(smaller, 1.7e9 + 60.0);
   ASSERT_EQ(table.size(), 19u);
-  for (size_t k = 19; k < 24; ++k) {
+  static_assert(PhasorTable::kFloatLanes == 16);
+  for (size_t k = 19; k < 32; ++k) {
     EXPECT_EQ(table.cos_f()[k], 0.0f) << k;
     EXPECT_EQ(table.sin_f()[k], 0.0f) << k;
   }

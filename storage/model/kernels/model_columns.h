@@ -29,9 +29,9 @@ class ModelColumns {
   explicit ModelColumns(int max_order);
 
   // Every column may be read this many entries past size(): a vector kernel loads whole vectors of
-  // eight at a run's end and drops the lanes past it, with no scalar tail (which was a fifth of
-  // PredictColumns' time in runs of 60). After the last model they are zeros: period index 0.
-  static constexpr size_t kReadablePast = 7;
+  // sixteen or eight at a run's end and drops the lanes past it, with no scalar tail (which was a
+  // fifth of PredictColumns' time in runs of 60). After the last model they are zeros: period index 0.
+  static constexpr size_t kReadablePast = 15;
 
   int max_order() const { return static_cast<int>(k_.size()); }
   size_t size() const { return order_.size(); }

@@ -1,9 +1,9 @@
 // ModelColumns and PredictColumns: the columns hold each published model at its own order, and a
 // run of them predicts bit for bit what the records give at each state's own order (PredictRecords
-// at order -1), as floats and as bytes, on the AVX2 path (Ω of up to 8, 16, 24 and 32 periods: one
-// to four vectors of the table) and the scalar one (more periods, or a machine without AVX2) alike,
-// for runs whose lengths are not multiples of eight, which start anywhere and end anywhere,
-// including at the columns' end.
+// at order -1), as floats and as bytes, on every path this machine can take: AVX-512 (Ω of up to
+// 16 and 32 periods: one or two vectors of the table), AVX2 (up to 8, 16, 24 and 32: one to four)
+// and scalar (any Ω), for runs whose lengths are not multiples of the vectors', which start
+// anywhere and end anywhere, including at the columns' end.
 #include "storage/model/kernels/model_columns.h"
 
 #include <gtest/gtest.h>
@@ -91,19 +91,34 @@ TEST(ModelColumnsTest, ShrinkThenGrowGivesZeroModels) {
   EXPECT_EQ(f.columns.alpha0()[9], f.models.header(f.records[9]).alpha0);  // the kept ones are kept
 }
 
+const char* PathName(ColumnsPath path) {
+  switch (path) {
+    case ColumnsPath::kAvx512: return "avx512";
+    case ColumnsPath::kAvx2: return "avx2";
+    case ColumnsPath::kScalar: return "scalar";
+  }
+  return "?";
+}
+
 // Runs of every length up to 40 at several starts, runs that end at the columns' last model, then one
 // longer than a block (256), at the highest own order of the run and at L: each value equals the
-// records' own-order prediction. For Ω of several sizes, which take the AVX2 path with one to four
-// vectors of the table, or the scalar one.
+// records' own-order prediction. For Ω of several sizes, on each path the machine can take, and
+// through PredictColumns (the fastest of them).
 class PredictColumnsTest : public ::testing::TestWithParam<int> {};
 
-TEST_P(PredictColumnsTest, EqualsPredictRecordsAtOwnOrders) {
+TEST_P(PredictColumnsTest, EqualsPredictRecordsAtOwnOrdersOnEveryPath) {
   const int period_count = GetParam();
   const Fixture f(700, *PeriodSet::Harmonics(kWeekSeconds, period_count));
+  ASSERT_TRUE(PredictColumnsCan(ColumnsPath::kScalar, f.periods.size()));
   if (period_count > 32) {
-    EXPECT_FALSE(PredictColumnsPermutes(f.periods.size()));
+    EXPECT_EQ(PredictColumnsPath(f.periods.size()), ColumnsPath::kScalar);
   }
-  ::testing::Test::RecordProperty("permutes", PredictColumnsPermutes(f.periods.size()) ? "yes" : "no");
+  std::string paths;
+  for (const ColumnsPath path : {ColumnsPath::kAvx512, ColumnsPath::kAvx2, ColumnsPath::kScalar}) {
+    if (PredictColumnsCan(path, f.periods.size())) paths += std::string(paths.empty() ? "" : ",") + PathName(path);
+  }
+  ::testing::Test::RecordProperty("paths", paths);
+  ::testing::Test::RecordProperty("chosen", PathName(PredictColumnsPath(f.periods.size())));
   for (const double t : {1.7e9, 1.7e9 + 12345.6, 1.7e9 + 86400.0 * 9.3}) {
     const PhasorTable table(f.periods, t);
     std::vector<float> expected(f.records.size());
@@ -112,18 +127,29 @@ TEST_P(PredictColumnsTest, EqualsPredictRecordsAtOwnOrders) {
       int highest = 0;
       for (size_t i = first; i < first + count; ++i) highest = std::max<int>(highest, f.columns.order()[i]);
       for (const int terms : {highest, kL}) {
+        const auto compare = [&](const char* path, const std::vector<float>& p, const std::vector<uint8_t>& q) {
+          for (size_t i = 0; i < count; ++i) {
+            // Bit for bit: the same IEEE operations in the same order.
+            ASSERT_EQ(std::memcmp(&p[i], &expected[first + i], sizeof(float)), 0)
+                << path << " t " << t << " run " << first << "+" << count << " terms " << terms << " model " << i;
+            ASSERT_EQ(q[i], QuantizeProbability(expected[first + i])) << path << " " << i;
+          }
+          EXPECT_EQ(p[count], 7.0f) << path;  // nothing written past the run
+          EXPECT_EQ(q[count], 77) << path;
+        };
         std::vector<float> p(count + 1, 7.0f);
         std::vector<uint8_t> q(count + 1, 77);
         PredictColumns(f.columns, first, count, terms, table, p.data());
         PredictColumnsU8(f.columns, first, count, terms, table, q.data());
-        for (size_t i = 0; i < count; ++i) {
-          // Bit for bit: the same IEEE operations in the same order.
-          ASSERT_EQ(std::memcmp(&p[i], &expected[first + i], sizeof(float)), 0)
-              << "t " << t << " run " << first << "+" << count << " terms " << terms << " model " << i;
-          ASSERT_EQ(q[i], QuantizeProbability(expected[first + i])) << i;
+        compare("chosen", p, q);
+        for (const ColumnsPath path : {ColumnsPath::kAvx512, ColumnsPath::kAvx2, ColumnsPath::kScalar}) {
+          if (!PredictColumnsCan(path, f.periods.size())) continue;
+          std::fill(p.begin(), p.end(), 7.0f);
+          std::fill(q.begin(), q.end(), 77);
+          PredictColumnsOn(path, f.columns, first, count, terms, table, p.data());
+          PredictColumnsOn(path, f.columns, first, count, terms, table, q.data());
+          compare(PathName(path), p, q);
         }
-        EXPECT_EQ(p[count], 7.0f);  // nothing written past the run
-        EXPECT_EQ(q[count], 77);
       }
     };
     for (size_t count = 0; count <= 40; ++count) {

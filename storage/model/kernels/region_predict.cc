@@ -6,7 +6,7 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
-// PredictColumns' AVX2 path, chosen at run time (x86-64 with GCC or Clang).
+// PredictColumns' AVX-512 and AVX2 paths, chosen at run time (x86-64 with GCC or Clang).
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #define FREMEN_COLUMNS_PERMUTE 1
@@ -208,22 +208,71 @@ void SumColumns(const ModelColumns& columns, size_t at, size_t n, int terms, con
 }
 
 #if FREMEN_COLUMNS_PERMUTE
-// The same sums eight models at a time, with the cosines and sines of their periods looked up by
-// vector permutes: the float tables of Ω (at most kPermuteParts · 8 periods, zero-padded to whole
-// vectors: PhasorTable::cos_f) are held in registers, and vpermps picks each model's entry from a
-// vector of eight by the index's low three bits; blends on bits 3 and 4 pick the vector. That is 3
-// permutes and 2 blends a table for the default 24 periods. g++ 12 builds AddComponent's vectors
-// from eight scalar loads each, and AVX2's gathers were slower than those loads on this machine's
-// AMD EPYC (docs/performance.md, "A brick's models in one run"). Multiplications, subtraction and
-// additions as separate IEEE operations in SumColumns' order, no FMA: each sum is SumColumns' to
-// the bit (this file is compiled with -ffp-contract=off, so no build fuses them).
-constexpr int kPermuteParts = 4;
+// The same sums several models at a time, with the cosines and sines of their periods looked up by
+// vector permutes: the float tables of Ω (at most 32 periods, zero-padded to whole vectors:
+// PhasorTable::cos_f) are held in registers. g++ 12 builds AddComponent's vectors from eight scalar
+// loads each, and AVX2's gathers were slower than those loads on this machine's AMD EPYC
+// (docs/performance.md, "A brick's models in one run"). Multiplications, subtraction and additions
+// as separate IEEE operations in SumColumns' order, no FMA: each sum is SumColumns' to the bit
+// (this file is compiled with -ffp-contract=off, so no build fuses them). Each vector is then
+// clamped (maxps and minps, as Clamp) and written out, quantised as QuantizeProbability (p · 255 +
+// 0.5 as two IEEE operations, then truncated). A run's last, partial vector reads past it
+// (ModelColumns::kReadablePast) and keeps only its first lanes.
+constexpr size_t kMostPermutedPeriods = 32;
+static_assert(ModelColumns::kReadablePast >= 15 && PhasorTable::kFloatLanes % 16 == 0);
 
-// Entry idx of the table held as kParts vectors of eight (idx < 8 · kParts). `bit3`, `bit4`: idx
-// shifted so that its bit 3 and bit 4 are the sign bits, which blendv reads.
+// GCC 12's avx512fintrin.h starts several intrinsics' results from _mm512_undefined_*(), which
+// -Wmaybe-uninitialized reports at each use once they are inlined here.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+
+// AVX-512: sixteen models at a time. The table is one vector of sixteen (Ω of up to 16 periods,
+// vpermps) or two (up to 32, vpermt2ps): one instruction a lookup.
 template <int kParts>
-[[gnu::target("avx2"), gnu::always_inline]] inline __m256 LookUp(const __m256* table, __m256i idx, __m256 bit3,
-                                                                 __m256 bit4) {
+[[gnu::target("avx512f"), gnu::always_inline]] inline __m512 LookUp16(const __m512* table, __m512i idx) {
+  if constexpr (kParts == 1) return _mm512_permutexvar_ps(idx, table[0]);
+  return _mm512_permutex2var_ps(table[0], idx, table[1]);
+}
+[[gnu::target("avx512f"), gnu::always_inline]] inline void Store16(__m512 p, __mmask16 lanes, float* out) {
+  _mm512_mask_storeu_ps(out, lanes, p);
+}
+[[gnu::target("avx512f"), gnu::always_inline]] inline void Store16(__m512 p, __mmask16 lanes, uint8_t* out) {
+  const __m512i q = _mm512_cvttps_epi32(_mm512_add_ps(_mm512_mul_ps(p, _mm512_set1_ps(255.0f)), _mm512_set1_ps(0.5f)));
+  _mm512_mask_cvtusepi32_storeu_epi8(out, lanes, q);
+}
+
+template <int kParts, typename Out>
+[[gnu::target("avx512f")]] void PredictColumns16(const ModelColumns& columns, size_t at, size_t n, int terms,
+                                                 const float* cos_t, const float* sin_t, Out* out) {
+  __m512 cos_v[kParts], sin_v[kParts];
+  for (int part = 0; part < kParts; ++part) {
+    cos_v[part] = _mm512_loadu_ps(cos_t + 16 * part);
+    sin_v[part] = _mm512_loadu_ps(sin_t + 16 * part);
+  }
+  const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
+  for (size_t i = 0; i < n; i += 16) {
+    __m512 p = _mm512_loadu_ps(columns.alpha0() + at + i);
+    for (int j = 0; j < terms; ++j) {
+      const __m512i idx =
+          _mm512_cvtepu16_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(columns.k(j) + at + i)));
+      const __m512 term =
+          _mm512_sub_ps(_mm512_mul_ps(_mm512_loadu_ps(columns.a(j) + at + i), LookUp16<kParts>(cos_v, idx)),
+                        _mm512_mul_ps(_mm512_loadu_ps(columns.b(j) + at + i), LookUp16<kParts>(sin_v, idx)));
+      p = _mm512_add_ps(p, term);
+    }
+    const __mmask16 lanes = n - i >= 16 ? 0xffff : static_cast<__mmask16>((1u << (n - i)) - 1);
+    Store16(_mm512_min_ps(one, _mm512_max_ps(zero, p)), lanes, out + i);
+  }
+}
+
+#pragma GCC diagnostic pop
+
+// AVX2: eight models at a time. vpermps picks from a vector of eight by the index's low three bits;
+// blends on bits 3 and 4 pick the vector: 3 permutes and 2 blends a lookup for the default 24
+// periods. `bit3`, `bit4`: the index shifted so that those bits are the sign bits, which blendv reads.
+template <int kParts>
+[[gnu::target("avx2"), gnu::always_inline]] inline __m256 LookUp8(const __m256* table, __m256i idx, __m256 bit3,
+                                                                  __m256 bit4) {
   const __m256 low = _mm256_permutevar8x32_ps(table[0], idx);
   if constexpr (kParts == 1) return low;
   const __m256 first16 = _mm256_blendv_ps(low, _mm256_permutevar8x32_ps(table[1], idx), bit3);
@@ -232,9 +281,6 @@ template <int kParts>
   if constexpr (kParts == 4) next16 = _mm256_blendv_ps(next16, _mm256_permutevar8x32_ps(table[3], idx), bit3);
   return _mm256_blendv_ps(first16, next16, bit4);
 }
-
-// Eight clamped probabilities as Emit writes them: floats, or bytes quantised as QuantizeProbability
-// does (p · 255 + 0.5 as two IEEE operations, then truncated).
 [[gnu::target("avx2"), gnu::always_inline]] inline void Store8(__m256 p, float* out) { _mm256_storeu_ps(out, p); }
 [[gnu::target("avx2"), gnu::always_inline]] inline void Store8(__m256 p, uint8_t* out) {
   const __m256i q = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(p, _mm256_set1_ps(255.0f)), _mm256_set1_ps(0.5f)));
@@ -242,18 +288,14 @@ template <int kParts>
   _mm_storel_epi64(reinterpret_cast<__m128i*>(out), _mm_packus_epi16(words, words));
 }
 
-// PredictColumns on this path: each vector of eight summed, clamped (maxps and minps, as Clamp) and
-// written out. A run's last, partial vector reads past it (ModelColumns::kReadablePast) and keeps
-// only its first lanes.
 template <int kParts, typename Out>
-[[gnu::target("avx2")]] void PredictColumnsPermuted(const ModelColumns& columns, size_t at, size_t n, int terms,
-                                                    const float* cos_t, const float* sin_t, Out* out) {
+[[gnu::target("avx2")]] void PredictColumns8(const ModelColumns& columns, size_t at, size_t n, int terms,
+                                             const float* cos_t, const float* sin_t, Out* out) {
   __m256 cos_v[kParts], sin_v[kParts];
   for (int part = 0; part < kParts; ++part) {
     cos_v[part] = _mm256_loadu_ps(cos_t + 8 * part);
     sin_v[part] = _mm256_loadu_ps(sin_t + 8 * part);
   }
-  static_assert(ModelColumns::kReadablePast >= 7);
   const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
   for (size_t i = 0; i < n; i += 8) {
     __m256 p = _mm256_loadu_ps(columns.alpha0() + at + i);
@@ -262,10 +304,9 @@ template <int kParts, typename Out>
           _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(columns.k(j) + at + i)));
       const __m256 bit3 = _mm256_castsi256_ps(_mm256_slli_epi32(idx, 28));
       const __m256 bit4 = _mm256_castsi256_ps(_mm256_slli_epi32(idx, 27));
-      const __m256 term = _mm256_sub_ps(_mm256_mul_ps(_mm256_loadu_ps(columns.a(j) + at + i),
-                                                      LookUp<kParts>(cos_v, idx, bit3, bit4)),
-                                        _mm256_mul_ps(_mm256_loadu_ps(columns.b(j) + at + i),
-                                                      LookUp<kParts>(sin_v, idx, bit3, bit4)));
+      const __m256 term = _mm256_sub_ps(
+          _mm256_mul_ps(_mm256_loadu_ps(columns.a(j) + at + i), LookUp8<kParts>(cos_v, idx, bit3, bit4)),
+          _mm256_mul_ps(_mm256_loadu_ps(columns.b(j) + at + i), LookUp8<kParts>(sin_v, idx, bit3, bit4)));
       p = _mm256_add_ps(p, term);
     }
     p = _mm256_min_ps(one, _mm256_max_ps(zero, p));
@@ -279,34 +320,45 @@ template <int kParts, typename Out>
   }
 }
 
+const bool kHasAvx512 = __builtin_cpu_supports("avx512f");
 const bool kHasAvx2 = __builtin_cpu_supports("avx2");
 #endif
 
-bool Permutes(size_t periods) {
+bool Can(ColumnsPath path, size_t periods) {
 #if FREMEN_COLUMNS_PERMUTE
-  return kHasAvx2 && periods <= 8 * kPermuteParts;
-#else
-  return false;
+  if (path == ColumnsPath::kAvx512) return kHasAvx512 && periods <= kMostPermutedPeriods;
+  if (path == ColumnsPath::kAvx2) return kHasAvx2 && periods <= kMostPermutedPeriods;
 #endif
+  return path == ColumnsPath::kScalar;
 }
 
-// PredictColumns: by permutes where the machine and Ω allow; else a block of models at a time,
-// summed, then clamped (and quantised) together.
+ColumnsPath PathFor(size_t periods) {
+  for (const ColumnsPath path : {ColumnsPath::kAvx512, ColumnsPath::kAvx2}) {
+    if (Can(path, periods)) return path;
+  }
+  return ColumnsPath::kScalar;
+}
+
+// PredictColumns on `path`; kScalar: a block of models at a time, summed, then clamped (and
+// quantised) together.
 template <typename Out>
-void ColumnsRange(const ModelColumns& columns, size_t first, size_t count, int terms, const PhasorTable& phasors,
-                  Out* out) {
+void ColumnsRange(ColumnsPath path, const ModelColumns& columns, size_t first, size_t count, int terms,
+                  const PhasorTable& phasors, Out* out) {
   const float *cos_t = phasors.cos_f(), *sin_t = phasors.sin_f();
 #if FREMEN_COLUMNS_PERMUTE
-  if (Permutes(phasors.size())) {
-    switch ((phasors.size() + 7) / 8) {
-      case 0:
-      case 1: return PredictColumnsPermuted<1>(columns, first, count, terms, cos_t, sin_t, out);
-      case 2: return PredictColumnsPermuted<2>(columns, first, count, terms, cos_t, sin_t, out);
-      case 3: return PredictColumnsPermuted<3>(columns, first, count, terms, cos_t, sin_t, out);
-      default: return PredictColumnsPermuted<4>(columns, first, count, terms, cos_t, sin_t, out);
-    }
+  const bool wide = phasors.size() > 16, wider = phasors.size() > 24;
+  if (path == ColumnsPath::kAvx512) {
+    return wide ? PredictColumns16<2>(columns, first, count, terms, cos_t, sin_t, out)
+                : PredictColumns16<1>(columns, first, count, terms, cos_t, sin_t, out);
+  }
+  if (path == ColumnsPath::kAvx2) {
+    if (phasors.size() <= 8) return PredictColumns8<1>(columns, first, count, terms, cos_t, sin_t, out);
+    if (!wide) return PredictColumns8<2>(columns, first, count, terms, cos_t, sin_t, out);
+    return wider ? PredictColumns8<4>(columns, first, count, terms, cos_t, sin_t, out)
+                 : PredictColumns8<3>(columns, first, count, terms, cos_t, sin_t, out);
   }
 #endif
+  (void)path;
   float raw[kBlock];
   for (size_t start = 0; start < count; start += kBlock) {
     const size_t n = std::min(kBlock, count - start);
@@ -319,15 +371,27 @@ void ColumnsRange(const ModelColumns& columns, size_t first, size_t count, int t
 
 void PredictColumns(const ModelColumns& columns, size_t first, size_t count, int terms, const PhasorTable& phasors,
                     float* out) {
-  ColumnsRange(columns, first, count, terms, phasors, out);
+  ColumnsRange(PathFor(phasors.size()), columns, first, count, terms, phasors, out);
 }
 
 void PredictColumnsU8(const ModelColumns& columns, size_t first, size_t count, int terms,
                       const PhasorTable& phasors, uint8_t* out) {
-  ColumnsRange(columns, first, count, terms, phasors, out);
+  ColumnsRange(PathFor(phasors.size()), columns, first, count, terms, phasors, out);
 }
 
-bool PredictColumnsPermutes(size_t periods) { return Permutes(periods); }
+ColumnsPath PredictColumnsPath(size_t periods) { return PathFor(periods); }
+
+bool PredictColumnsCan(ColumnsPath path, size_t periods) { return Can(path, periods); }
+
+void PredictColumnsOn(ColumnsPath path, const ModelColumns& columns, size_t first, size_t count, int terms,
+                      const PhasorTable& phasors, float* out) {
+  ColumnsRange(path, columns, first, count, terms, phasors, out);
+}
+
+void PredictColumnsOn(ColumnsPath path, const ModelColumns& columns, size_t first, size_t count, int terms,
+                      const PhasorTable& phasors, uint8_t* out) {
+  ColumnsRange(path, columns, first, count, terms, phasors, out);
+}
 
 void PredictRegion(const CompactModels& models, size_t first, size_t count, const PhasorTable& phasors, int order,
                    float* out) {

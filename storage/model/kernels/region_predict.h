@@ -48,10 +48,22 @@ void PredictColumns(const ModelColumns& columns, size_t first, size_t count, int
 // The same, quantised (QuantizeProbability).
 void PredictColumnsU8(const ModelColumns& columns, size_t first, size_t count, int terms,
                       const PhasorTable& phasors, uint8_t* out);
-// Whether PredictColumns takes its AVX2 path, eight models at a time with the table of Ω's periods in
-// registers, for an Ω of `periods` periods on this machine (up to 32, with AVX2); else it is scalar.
-// For tests and logs: both give the same bits.
-bool PredictColumnsPermutes(size_t periods);
+
+// The ways PredictColumns can sum a run, each giving the same bits: with Ω's cosines and sines held
+// in vector registers and looked up by permutes, sixteen models at a time (AVX-512) or eight (AVX2),
+// for an Ω of up to 32 periods; or one model at a time.
+enum class ColumnsPath { kAvx512, kAvx2, kScalar };
+// The fastest path this machine and build can take for an Ω of `periods` periods: the one
+// PredictColumns takes.
+ColumnsPath PredictColumnsPath(size_t periods);
+// Whether they can take `path` for such an Ω (kScalar always).
+bool PredictColumnsCan(ColumnsPath path, size_t periods);
+// PredictColumns (PredictColumnsU8) on a given path, for tests and benchmarks.
+// REQUIRES: PredictColumnsCan(path, phasors.size()).
+void PredictColumnsOn(ColumnsPath path, const ModelColumns& columns, size_t first, size_t count, int terms,
+                      const PhasorTable& phasors, float* out);
+void PredictColumnsOn(ColumnsPath path, const ModelColumns& columns, size_t first, size_t count, int terms,
+                      const PhasorTable& phasors, uint8_t* out);
 
 // Every record of `models`.
 inline void PredictRegion(const CompactModels& models, const PhasorTable& phasors, int order, float* out) {
