@@ -2,8 +2,6 @@
 
 #include <algorithm>
 
-#include "storage/model/kernels/record_buffer.h"
-
 namespace fremen::storage {
 
 BrickModels::BrickModels(std::span<const BrickImage> images, const model::CompactModels& models, uint64_t generation)
@@ -34,12 +32,6 @@ BrickModels::BrickModels(std::span<const BrickImage> images, const model::Compac
     brick.others_count = static_cast<uint32_t>(others_.size()) - brick.others_first;
     brick.covered = static_cast<uint32_t>(images[b].dynamic().size());
   }
-}
-
-void BrickModels::Prefetch(size_t i) const {
-  const Brick& brick = bricks_[i];
-  models_.Prefetch(brick.first, brick.count, brick.terms);
-  model::PrefetchForRead(cells_.data() + brick.first, brick.count * sizeof(uint16_t));
 }
 
 size_t BrickModels::memory_bytes() const {

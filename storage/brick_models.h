@@ -57,8 +57,6 @@ class BrickModels {
   // The row-major index in its brick of the cell of each copied model.
   uint16_t cell(size_t i) const { return cells_[i]; }
   const uint16_t* cells() const { return cells_.data(); }
-  // Starts reading brick i's copied models and cells into the cache (a region's next brick).
-  void Prefetch(size_t i) const;
   // The covered dynamic cells that had no published model.
   const BrickImage::DynamicCell* others() const { return others_.data(); }
   size_t memory_bytes() const;

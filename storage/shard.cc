@@ -641,12 +641,6 @@ void Shard::PredictBox(const CellBox& box, const model::PhasorTable& table, cons
   walk.PrefetchImage(0);
   for (size_t b = 0; b < walk.bricks.size(); ++b) {
     walk.PrefetchImage(b + 1);
-    // The next brick's copied models too: a brick's run is a few lines of each column, wherever the
-    // brick was copied, which the hardware's stream prefetch does not foresee.
-    if (brick_models != nullptr && b + 1 < walk.bricks.size()) {
-      const size_t next = walk.bricks[b + 1].image - images_.data();
-      if (next < brick_models->size()) brick_models->Prefetch(next);
-    }
     const BoxWalk::BoxBrick& brick = walk.bricks[b];
     const BrickImage& image = *brick.image;
     if (held != nullptr) held[box_bricks.Index(brick.bx, brick.by, brick.bz)] = 1;

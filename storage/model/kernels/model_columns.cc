@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cassert>
 
-#include "storage/model/kernels/record_buffer.h"
-
 namespace fremen::model {
 
 ModelColumns::ModelColumns(int max_order) : k_(max_order), a_(max_order), b_(max_order) {}
@@ -39,15 +37,6 @@ void ModelColumns::SetZero(size_t i, const CompactModels& models, size_t r) {
     k_[j][i] = models.k(r)[j];
     a_[j][i] = models.a(r)[j];
     b_[j][i] = models.b(r)[j];
-  }
-}
-
-void ModelColumns::Prefetch(size_t first, size_t count, int terms) const {
-  PrefetchForRead(alpha0_.data() + first, count * sizeof(float));
-  for (int j = 0; j < terms; ++j) {
-    PrefetchForRead(k_[j].data() + first, count * sizeof(uint16_t));
-    PrefetchForRead(a_[j].data() + first, count * sizeof(float));
-    PrefetchForRead(b_[j].data() + first, count * sizeof(float));
   }
 }
 

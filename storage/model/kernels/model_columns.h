@@ -48,9 +48,6 @@ class ModelColumns {
   const float* a(int j) const { return a_[j].data(); }
   const float* b(int j) const { return b_[j].data(); }
   size_t memory_bytes() const;
-  // Starts reading models [first, first + count)'s alpha0 and first `terms` components into the
-  // cache: a run a region will predict next (Shard::PredictBox, a brick ahead).
-  void Prefetch(size_t first, size_t count, int terms) const;
 
  private:
   std::vector<float> alpha0_;
