@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
+#include <vector>
 
 #include "base/compact_scan.h"
 #include "storage/state_names.h"
@@ -107,6 +109,34 @@ TEST(IngestConvertTest, CellsWithoutZAreInTheFirstLayer) {
   auto batch = BatchFromRequest(map, request);
   ASSERT_TRUE(batch.ok()) << batch.status();
   EXPECT_THAT(batch->keys, ElementsAre(map.grid.keys().Key(4, 5, 0)));
+}
+
+// Enough cells for the vector loops of the conversion (AVX2 or not, as the loader chose), not only
+// their tails: each key is the one GridKeys gives for its cell, or the outside key, in each key
+// layout, with z sent and without it.
+TEST(IngestConvertTest, ManyCellsBecomeTheKeysOfEachCellInEveryLayout) {
+  std::mt19937 rng(11);
+  for (const uint32_t nz : {1u, 4u}) {
+    for (const bool with_z : {true, false}) {
+      const storage::MapInfo map = Grid(300, 200, nz);
+      v1::IngestRequest request = Request();
+      std::vector<uint64_t> want;
+      for (int i = 0; i < 1003; ++i) {
+        // About one cell in eight outside the grid, some far enough to alias inside once packed.
+        const uint32_t x = rng() % 8 == 0 ? 300 + rng() % (1u << 22) : rng() % 300;
+        const uint32_t y = rng() % 200, z = with_z ? rng() % (nz + 1) : 0;
+        v1::CellIndices* cells = request.mutable_cells()->mutable_cells();
+        cells->add_x(x);
+        cells->add_y(y);
+        if (with_z) cells->add_z(z);
+        request.mutable_cells()->add_values(1.0f);
+        want.push_back(x < 300 && z < nz ? map.grid.keys().Key(x, y, z) : kOutsideMapKey);
+      }
+      auto batch = BatchFromRequest(map, request);
+      ASSERT_TRUE(batch.ok()) << batch.status();
+      EXPECT_EQ(batch->keys, want) << "nz " << nz << " with z " << with_z;
+    }
+  }
 }
 
 TEST(IngestConvertTest, CellsOutsideTheGridAreRejectedByTheStoreAsOutsideTheMap) {

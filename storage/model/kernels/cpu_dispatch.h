@@ -6,10 +6,11 @@
 // build's own target, and pick one when the binary is loaded (an ifunc resolver: no cost per call).
 // The whole kernel must be inside the cloned function to profit: [[gnu::flatten]] inlines the
 // helpers it calls (FoldObservation, the prefetches) into each clone. Used on ApplyScan,
-// ApplyDenseScan and WideBodies::Fold only: region prediction is scalar per cell (its loop over a
-// state's few components is a dependent sum) and measured no better as an AVX2 clone. (PredictColumns,
-// the region kernel over a brick's models as columns, has its own AVX2 path written with intrinsics
-// and chosen at run time: region_predict.cc.)
+// ApplyDenseScan, WideBodies::Fold, the lossless estimator's AddApproximate, and the ingest's
+// conversion of cells to keys (server/convert/ingest_convert.cc). Region prediction over records
+// is scalar per cell (its loop over a state's few components is a dependent sum) and measured no
+// better as an AVX2 clone; PredictColumns, the region kernel over a brick's models as columns, has
+// its own AVX-512 and AVX2 paths written with intrinsics and chosen at run time (region_predict.cc).
 //
 // The clone is "avx2", deliberately not "arch=x86-64-v3": that one includes FMA, and with FMA the
 // compiler fuses a·b + c into one rounding (C++'s default -ffp-contract=fast), so the AVX2 path would
