@@ -222,9 +222,11 @@ constexpr size_t kMostPermutedPeriods = 32;
 static_assert(ModelColumns::kReadablePast >= 15 && PhasorTable::kFloatLanes % 16 == 0);
 
 // GCC 12's avx512fintrin.h starts several intrinsics' results from _mm512_undefined_*(), which
-// -Wmaybe-uninitialized reports at each use once they are inlined here.
+// -Wmaybe-uninitialized reports at each use once they are inlined here (clang has no such warning).
+#if !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 
 // AVX-512: sixteen models at a time. The table is one vector of sixteen (Ω of up to 16 periods,
 // vpermps) or two (up to 32, vpermt2ps): one instruction a lookup.
@@ -265,7 +267,9 @@ template <int kParts, typename Out>
   }
 }
 
+#if !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 // AVX2: eight models at a time. vpermps picks from a vector of eight by the index's low three bits;
 // blends on bits 3 and 4 pick the vector: 3 permutes and 2 blends a lookup for the default 24
